@@ -1,0 +1,33 @@
+# shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
+# Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
+# then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
+from snakemake.utils import validate
+
+from shockcal.config import check_semantics
+
+
+configfile: "config/config.yaml"
+
+
+validate(config, schema="workflow/schemas/config.schema.yaml")
+check_semantics(config, source="config")
+
+RESULTS = config["study"]["results_dir"]
+SHOTS = list(config["shots"])
+ALL_TARGETS = []
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/design.smk"
+include: "workflow/rules/simulate.smk"
+include: "workflow/rules/features.smk"
+include: "workflow/rules/emulator.smk"
+include: "workflow/rules/calibrate.smk"
+include: "workflow/rules/predict.smk"
+include: "workflow/rules/figures.smk"
+
+
+rule all:
+    default_target: True
+    input:
+        ALL_TARGETS,

@@ -1,0 +1,59 @@
+"""The `shockcal` command: one subcommand per workflow stage, each usable without Snakemake.
+
+Each stage lives in its own module under shockcal.cli with `register(subparsers)`, which adds
+its parser and sets `func`. Modules import heavy libraries (numba, scikit-learn, matplotlib)
+inside their handlers so that `shockcal --help` and argument errors stay fast.
+Exit codes: 0 success, 2 a user error (bad config, table or record: the message says which).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+
+from shockcal import __version__
+from shockcal.errors import ShockcalError
+
+STAGE_MODULES = [
+    "shockcal.cli.design",
+    "shockcal.cli.simulate",
+    "shockcal.cli.features",
+    "shockcal.cli.emulate",
+    "shockcal.cli.calibrate",
+    "shockcal.cli.predict",
+    "shockcal.cli.figures",
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="shockcal", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"shockcal {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in STAGE_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name == name:  # stage not written yet
+                continue
+            raise
+        module.register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(asctime)s %(name)s %(levelname)s: %(message)s", stream=sys.stderr)
+    try:
+        return int(args.func(args) or 0)
+    except ShockcalError as exc:
+        print(f"shockcal {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,128 @@
+"""Study configuration: load YAML, validate against the JSON schema, check cross-field rules.
+
+The schema (config.schema.yaml beside this file, also used by the Snakefile) fills defaults and
+checks types and ranges; `check_semantics` adds the rules a schema cannot express. Relative paths
+in a config (design.file, observed.records.*.path) are relative to the working directory, which
+for the workflow is the repository root.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from shockcal.errors import ConfigError
+
+SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
+
+# Johnson-Cook strength inputs shared by every shot (SPEC section 3), in Table IV units.
+STRENGTH_INPUTS = ("A", "B", "C", "n", "m")
+
+
+def load_config(path: str | Path) -> dict:
+    """Read a YAML config, fill schema defaults and reject anything invalid, naming the key."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"config file {path} does not exist")
+    try:
+        config = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"config file {path} is not valid YAML: {exc}") from exc
+    if not isinstance(config, dict):
+        raise ConfigError(f"config file {path} must hold a mapping at the top level")
+    return validate_config(config, source=str(path))
+
+
+def validate_config(config: dict, source: str = "config") -> dict:
+    """Validate a config mapping in place (schema + semantics) and return it."""
+    from jsonschema.exceptions import ValidationError
+    from snakemake.exceptions import WorkflowError
+    from snakemake.utils import validate
+
+    _normalise_shot_names(config)
+    try:
+        validate(config, schema=str(SCHEMA_PATH), set_default=True)
+    except (WorkflowError, ValidationError) as exc:
+        raise ConfigError(f"{source}: {_schema_message(exc)}") from None
+    check_semantics(config, source)
+    return config
+
+
+def _normalise_shot_names(config: dict) -> None:
+    """YAML reads an unquoted shot name like 104 as an int; shot names are strings."""
+    for section in (config.get("shots"), (config.get("observed") or {}).get("features"),
+                    (config.get("observed") or {}).get("records")):
+        if isinstance(section, dict):
+            for key in [k for k in section if not isinstance(k, str)]:
+                section[str(key)] = section.pop(key)
+
+
+def _schema_message(exc: Exception) -> str:
+    """Turn a jsonschema error (snakemake wraps it; the original is its context) into 'key.path: reason'."""
+    from jsonschema.exceptions import ValidationError
+
+    err = exc if isinstance(exc, ValidationError) else exc.__context__
+    if not isinstance(err, ValidationError):
+        return str(exc).strip()
+    key = ".".join(str(p) for p in err.absolute_path) or "<top level>"
+    return f"{key}: {err.message}"
+
+
+def check_semantics(config: dict, source: str = "config") -> None:
+    """Rules beyond the schema: box bounds ordered, shot mappings name real inputs, files exist."""
+    inputs = config["inputs"]
+    for name, box in inputs.items():
+        if not box["min"] < box["max"]:
+            raise ConfigError(f"{source}: inputs.{name}: min ({box['min']}) must be below max ({box['max']})")
+    for name in STRENGTH_INPUTS:
+        if name not in inputs:
+            raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {STRENGTH_INPUTS} are required")
+        if inputs[name]["min"] < 0:
+            raise ConfigError(f"{source}: inputs.{name}.min: Johnson-Cook parameters cannot be negative")
+    for shot, spec in config["shots"].items():
+        mapped = [("velocity_input", spec["velocity_input"])]
+        mapped += [(f"shear_modulus_inputs[{i}]", name) for i, name in enumerate(spec["shear_modulus_inputs"])]
+        for key, name in mapped:
+            if name not in inputs:
+                raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
+    design_file = config["design"].get("file")
+    if design_file and not Path(design_file).is_file():
+        raise ConfigError(f"{source}: design.file: {design_file} does not exist")
+    observed = config["observed"]
+    for section in ("features", "records"):
+        for shot in observed[section]:
+            if shot not in config["shots"]:
+                raise ConfigError(f"{source}: observed.{section}.{shot}: unknown shot; known shots are {sorted(config['shots'])}")
+    for shot, record in observed["records"].items():
+        if not Path(record["path"]).is_file():
+            raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
+
+
+def shot_config(config: dict, shot: str) -> dict:
+    """The config block of one shot, or a ConfigError listing the known shots."""
+    try:
+        return config["shots"][shot]
+    except KeyError:
+        raise ConfigError(f"unknown shot '{shot}'; the config defines {sorted(config['shots'])}") from None
+
+
+def shot_inputs(config: dict, shot: str) -> list[str]:
+    """Design columns one shot depends on: A, B, C, n, m, its velocity, its shear-modulus terms."""
+    spec = shot_config(config, shot)
+    return [*STRENGTH_INPUTS, spec["velocity_input"], *spec["shear_modulus_inputs"]]
+
+
+def input_names(config: dict) -> list[str]:
+    """All calibration inputs in config order (the design table's columns)."""
+    return list(config["inputs"])
+
+
+def input_bounds(config: dict, names: list[str] | None = None):
+    """(lower, upper) arrays of the prior box for `names` (default: all inputs), native units."""
+    import numpy as np
+
+    names = input_names(config) if names is None else names
+    lower = np.array([config["inputs"][k]["min"] for k in names], dtype=float)
+    upper = np.array([config["inputs"][k]["max"] for k in names], dtype=float)
+    return lower, upper

@@ -1,0 +1,96 @@
+"""Design tables: the seeded Latin hypercube over the prior box, user designs, and the per-shot mapping.
+
+A design table has one row per run: an integer `run` id and one column per calibration input
+(A, B, C, n, m, V1, V2, V3, G1, Delta2, Delta3 for the paper's study) in the box's native units
+(Mbar for A, B and shear moduli; cm/us for velocities; C, n, m dimensionless). One design serves
+every shot: `shot_parameters` maps a row onto one shot (SPEC section 3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from shockcal.config import STRENGTH_INPUTS, input_bounds, input_names, shot_config
+from shockcal.errors import InputError
+from shockcal.io import read_table, require_columns
+
+
+def latin_hypercube(config: dict, n_runs: int, seed: int) -> pd.DataFrame:
+    """A seeded Latin hypercube of `n_runs` points over the config's input box (scipy.stats.qmc)."""
+    from scipy.stats import qmc
+
+    names = input_names(config)
+    lower, upper = input_bounds(config, names)
+    unit = qmc.LatinHypercube(d=len(names), seed=np.random.default_rng(seed)).random(n_runs)
+    design = pd.DataFrame(qmc.scale(unit, lower, upper), columns=names)
+    design.insert(0, "run", np.arange(n_runs, dtype=np.int64))
+    return design
+
+
+def load_design(path: str | Path, config: dict, columns: list[str] | None = None) -> pd.DataFrame:
+    """Read a CSV/Parquet design, check it, and return it with an integer `run` column.
+
+    `columns` are the inputs that must be present (default: all config inputs). Values must be
+    finite; Johnson-Cook inputs non-negative; velocities and shear moduli positive (checked per
+    shot by `shot_parameters`). Errors name the file, the row and the parameter.
+    """
+    design = read_table(path)
+    columns = input_names(config) if columns is None else columns
+    require_columns(design, columns, path)
+    if "run" not in design.columns:
+        design.insert(0, "run", np.arange(len(design), dtype=np.int64))
+    if design["run"].duplicated().any():
+        dup = design.loc[design["run"].duplicated(), "run"].iloc[0]
+        raise InputError(f"{path}: run id {dup} appears more than once")
+    for name in columns:
+        values = pd.to_numeric(design[name], errors="coerce")
+        bad = ~np.isfinite(values.to_numpy(dtype=float))
+        if bad.any():
+            row = design.loc[bad, "run"].iloc[0]
+            raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({design.loc[bad, name].iloc[0]!r})")
+        design[name] = values.astype(float)
+        if name in STRENGTH_INPUTS and (values < 0).any():
+            row = design.loc[values < 0, "run"].iloc[0]
+            raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
+    design["run"] = design["run"].astype(np.int64)
+    return design.reset_index(drop=True)
+
+
+@dataclass(frozen=True)
+class ShotParameters:
+    """The inputs of one hydrocode run of one shot, in the paper's units (Mbar, cm/us)."""
+
+    A: float
+    B: float
+    C: float
+    n: float
+    m: float
+    velocity_cm_us: float
+    shear_modulus_Mbar: float
+
+
+def shot_parameters(row, config: dict, shot: str) -> ShotParameters:
+    """Map one design row onto a shot: its velocity input and G = sum of its shear-modulus inputs."""
+    spec = shot_config(config, shot)
+    return ShotParameters(
+        *(float(row[k]) for k in STRENGTH_INPUTS),
+        velocity_cm_us=float(row[spec["velocity_input"]]),
+        shear_modulus_Mbar=float(sum(row[k] for k in spec["shear_modulus_inputs"])),
+    )
+
+
+def validate_shot_parameters(design: pd.DataFrame, config: dict, shot: str, source: str | Path) -> None:
+    """Reject rows whose shot velocity or shear modulus is not positive, before any run starts."""
+    spec = shot_config(config, shot)
+    velocity = design[spec["velocity_input"]].to_numpy(dtype=float)
+    shear = design[spec["shear_modulus_inputs"]].to_numpy(dtype=float).sum(axis=1)
+    for label, values in ((f"impact velocity {spec['velocity_input']}", velocity),
+                          (f"shear modulus {'+'.join(spec['shear_modulus_inputs'])}", shear)):
+        bad = values <= 0
+        if bad.any():
+            row = design.loc[bad, "run"].iloc[0]
+            raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {shot}")

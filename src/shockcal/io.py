@@ -1,0 +1,73 @@
+"""Tables on disk: Parquet (pyarrow) for everything shockcal writes, CSV accepted wherever a table is read.
+
+Each table shockcal writes carries a JSON document under the Parquet schema-metadata key
+``shockcal`` (units of its columns, the producing command, its version): read it with
+`read_table_metadata`. Writes go to a temporary file renamed into place, so an interrupted job never
+leaves a half-written table that a rerun would mistake for a finished one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from shockcal.errors import InputError
+
+METADATA_KEY = b"shockcal"
+PARQUET_SUFFIXES = {".parquet", ".pq"}
+CSV_SUFFIXES = {".csv"}
+
+
+def read_table(path: str | Path) -> pd.DataFrame:
+    """Read a Parquet or CSV table; the error names the file when it is missing or unreadable."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"table {path} does not exist")
+    suffix = path.suffix.lower()
+    try:
+        if suffix in PARQUET_SUFFIXES:
+            return pd.read_parquet(path)
+        if suffix in CSV_SUFFIXES:
+            return pd.read_csv(path)
+    except Exception as exc:  # pyarrow and pandas raise many types; all mean "unreadable"
+        raise InputError(f"table {path} could not be read: {exc}") from exc
+    raise InputError(f"table {path}: unknown format '{suffix}' (expected .parquet, .pq or .csv)")
+
+
+def write_table(df: pd.DataFrame, path: str | Path, metadata: dict | None = None) -> Path:
+    """Write `df` as Parquet atomically, with `metadata` (JSON-serialisable) in the schema."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    if metadata is not None:
+        merged = dict(table.schema.metadata or {})
+        merged[METADATA_KEY] = json.dumps(metadata, sort_keys=True).encode()
+        table = table.replace_schema_metadata(merged)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    pq.write_table(table, tmp)
+    os.replace(tmp, path)
+    return path
+
+
+def read_table_metadata(path: str | Path) -> dict:
+    """The shockcal metadata of a Parquet table written by `write_table` ({} for CSV or none)."""
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    if path.suffix.lower() not in PARQUET_SUFFIXES:
+        return {}
+    raw = (pq.read_schema(path).metadata or {}).get(METADATA_KEY)
+    return json.loads(raw) if raw else {}
+
+
+def require_columns(df: pd.DataFrame, columns, source: str | Path) -> None:
+    """Raise InputError naming `source` and every missing column."""
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise InputError(f"{source}: missing column(s) {missing}; found {list(df.columns)}")

@@ -1,0 +1,1 @@
+# calibrate rules (see docs/workflow.md)

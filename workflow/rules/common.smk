@@ -1,0 +1,1 @@
+# common rules (see docs/workflow.md)

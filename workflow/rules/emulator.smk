@@ -1,0 +1,1 @@
+# emulator rules (see docs/workflow.md)

@@ -1,0 +1,1 @@
+# features rules (see docs/workflow.md)

@@ -1,0 +1,1 @@
+# predict rules (see docs/workflow.md)

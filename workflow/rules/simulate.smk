@@ -1,0 +1,1 @@
+# simulate rules (see docs/workflow.md)
