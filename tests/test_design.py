@@ -1,0 +1,62 @@
+"""Design tables: the seeded Latin hypercube, user designs and the per-shot mapping."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shockcal.design import latin_hypercube, load_design, shot_parameters, validate_shot_parameters
+from shockcal.errors import InputError
+
+
+def test_latin_hypercube_fills_the_box_one_point_per_stratum(paper_config):
+    design = latin_hypercube(paper_config, 50, seed=3)
+    assert list(design["run"]) == list(range(50))
+    for name, box in paper_config["inputs"].items():
+        strata = np.floor((design[name] - box["min"]) / (box["max"] - box["min"]) * 50).astype(int)
+        assert sorted(strata) == list(range(50)), name
+
+
+def test_latin_hypercube_is_reproducible_and_seed_dependent(paper_config):
+    a = latin_hypercube(paper_config, 20, seed=7)
+    pd.testing.assert_frame_equal(a, latin_hypercube(paper_config, 20, seed=7))
+    assert not a.equals(latin_hypercube(paper_config, 20, seed=8))
+
+
+def test_shot_mapping_sums_shear_modulus_terms(paper_config):
+    row = {"A": 0.002, "B": 0.004, "C": 0.01, "n": 0.5, "m": 1.0, "V1": 0.0204, "V2": 0.0355,
+           "V3": 0.0484, "G1": 0.27, "Delta2": 0.01, "Delta3": 0.02}
+    p104 = shot_parameters(row, paper_config, "104S")
+    p106 = shot_parameters(row, paper_config, "106S")
+    assert p104.velocity_cm_us == 0.0204 and p104.shear_modulus_Mbar == pytest.approx(0.27)
+    assert p106.velocity_cm_us == 0.0484 and p106.shear_modulus_Mbar == pytest.approx(0.30)
+
+
+def test_load_design_reads_csv_and_adds_run(tmp_path, paper_config):
+    design = latin_hypercube(paper_config, 5, seed=1).drop(columns="run")
+    path = tmp_path / "d.csv"
+    design.to_csv(path, index=False)
+    loaded = load_design(path, paper_config)
+    assert list(loaded["run"]) == [0, 1, 2, 3, 4]
+    np.testing.assert_allclose(loaded["A"], design["A"])
+
+
+@pytest.mark.parametrize("mutate, message", [
+    (lambda d: d.drop(columns="Delta3"), "missing column"),
+    (lambda d: d.assign(n=[0.1, -0.2, 0.3]), "run 1: parameter n"),
+    (lambda d: d.assign(A=[0.001, np.nan, 0.001]), "run 1: parameter A is not a finite number"),
+    (lambda d: d.assign(run=[4, 4, 5]), "run id 4 appears more than once"),
+])
+def test_load_design_rejects_bad_tables_naming_row_and_parameter(tmp_path, paper_config, mutate, message):
+    path = tmp_path / "bad.csv"
+    mutate(latin_hypercube(paper_config, 3, seed=1)).to_csv(path, index=False)
+    with pytest.raises(InputError, match=message) as err:
+        load_design(path, paper_config)
+    assert "bad.csv" in str(err.value)
+
+
+def test_non_positive_shot_velocity_is_rejected_before_running(paper_config):
+    design = latin_hypercube(paper_config, 3, seed=1)
+    design.loc[2, "V2"] = 0.0
+    validate_shot_parameters(design, paper_config, "104S", "d.csv")  # 104S does not use V2
+    with pytest.raises(InputError, match="run 2: impact velocity V2"):
+        validate_shot_parameters(design, paper_config, "105S", "d.csv")
