@@ -1,0 +1,59 @@
+"""`shockcal predict` (joint-posterior draws as a design for hydrocode runs) and `shockcal predict-emulator`."""
+
+from __future__ import annotations
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("predict", help="draw joint-posterior samples as a design table for hydrocode runs")
+    p.add_argument("--config", required=True, help="study config YAML")
+    p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
+    p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
+    p.add_argument("--n-runs", type=int, default=None, help="override predict.n_posterior_runs")
+    p.add_argument("--seed", type=int, default=None, help="override the seed (default: study.seed + offset)")
+    p.set_defaults(func=run)
+
+    e = subparsers.add_parser("predict-emulator", help="emulator predictions of the features at a design's rows")
+    e.add_argument("--config", required=True, help="study config YAML")
+    e.add_argument("--design", required=True, help="design table, e.g. the posterior draws of `shockcal predict`")
+    e.add_argument("--emulator", required=True, help="emulator directory written by `shockcal emulate`")
+    e.add_argument("--out", required=True, help="output Parquet table: run, shot, features and their sd (m/s)")
+    e.set_defaults(func=run_emulator)
+
+
+def run(args) -> int:
+    import logging
+
+    from shockcal.config import load_config
+    from shockcal.io import read_table, write_table
+    from shockcal.predict import SEED_OFFSET, draw_posterior_design
+
+    config = load_config(args.config)
+    n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
+    seed = config["study"]["seed"] + SEED_OFFSET if args.seed is None else args.seed
+    design = draw_posterior_design(read_table(args.posterior), config, n_runs, seed, source=args.posterior)
+    units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
+    write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
+                                   "units": units})
+    logging.getLogger("shockcal.predict").info("wrote %d posterior draws (seed %d) to %s", len(design), seed, args.out)
+    return 0
+
+
+def run_emulator(args) -> int:
+    import logging
+
+    from shockcal.config import load_config
+    from shockcal.design import load_design
+    from shockcal.emulator import Emulator
+    from shockcal.io import write_table
+    from shockcal.predict import emulator_predictions
+
+    config = load_config(args.config)
+    emulator = Emulator.load(args.emulator)
+    shots = [s for s in config["shots"] if s in emulator.shots]
+    design = load_design(args.design, config)
+    table = emulator_predictions(emulator, design, shots)
+    write_table(table, args.out, {"table": "emulator_predictions", "design": args.design, "emulator": args.emulator,
+                                  "units": "m/s"})
+    logging.getLogger("shockcal.predict").info("wrote emulator predictions for %d runs x %d shots to %s",
+                                               len(design), len(shots), args.out)
+    return 0

@@ -1,0 +1,166 @@
+"""The paper's fifteen figures by file name: what each reads and which function draws it.
+
+Importing this module is cheap (the Snakefile lists the figures from it); plotting modules are
+imported when a figure is built.
+
+Inputs arrive as named files (`FigureInputs`): keys such as `observed`, `cv`, `emulator_predictions`
+or `<kind>:<shot or calibration>` (`posterior:joint`, `features:104S`, `simulations:104S`,
+`predicted_features:104S`, `predicted_simulations:104S`, `record:104S`); a key may name several
+files (simulation chunks), which are concatenated. A key that was not given reads as None and the
+figure shows a "no data" note; a given file that is missing or unreadable is an InputError.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import partial
+from typing import Callable
+
+from shockcal.errors import InputError
+
+
+class FigureInputs:
+    """Named input files of one figure, read on demand."""
+
+    def __init__(self, files: dict[str, list[str]] | None = None):
+        self.files = dict(files or {})
+
+    def table(self, key: str) -> pd.DataFrame | None:
+        """The table(s) under `key`, concatenated; None when the key was not given."""
+        import pandas as pd
+
+        from shockcal.io import read_table
+
+        paths = self.files.get(key)
+        if not paths:
+            return None
+        tables = [read_table(p) for p in paths]
+        return tables[0] if len(tables) == 1 else pd.concat(tables, ignore_index=True)
+
+    def per(self, kind: str, names) -> dict[str, pd.DataFrame | None]:
+        """{name: table of `kind:name`} for each name."""
+        return {name: self.table(f"{kind}:{name}") for name in names}
+
+    def record(self, shot: str) -> pd.DataFrame | None:
+        """The measured record of `shot` (t_us, v_m_s), read with the project's record reader."""
+        paths = self.files.get(f"record:{shot}")
+        if not paths:
+            return None
+        from shockcal.records import read_record
+
+        return read_record(paths[0])
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    name: str
+    category: str
+    build: Callable  # (FigureInputs, config) -> matplotlib Figure
+
+
+def _shots(config) -> list[str]:
+    return list(config["shots"])
+
+
+def _toy(name, inputs, config):
+    from shockcal.plots import toys
+
+    return getattr(toys, name)()
+
+
+def _records(inputs, config):
+    from shockcal.plots.records import fig02_records
+
+    shots = _shots(config)
+    return fig02_records({s: inputs.record(s) for s in shots}, inputs.table("observed"), shots)
+
+
+def _trace_figure(which, inputs, config):
+    from shockcal.plots import mixture
+
+    shot = _shots(config)[0]
+    trace, label = mixture.pick_trace(inputs.record(shot), inputs.table(f"simulations:{shot}"), shot)
+    return getattr(mixture, which)(trace, label, config, shot)
+
+
+def _crossval(inputs, config):
+    from shockcal.plots.crossval import fig06_crossval
+
+    return fig06_crossval(inputs.table("cv"), _shots(config))
+
+
+def _marginals(inputs, config):
+    from shockcal.plots.posterior import fig07_marginals
+
+    return fig07_marginals(inputs.per("posterior", [*_shots(config), "joint"]), config)
+
+
+def _pairs(inputs, config):
+    from shockcal.plots.posterior import fig08_pairs
+
+    return fig08_pairs(inputs.table("posterior:joint"), config)
+
+
+def _features_emulator(inputs, config):
+    from shockcal.plots.feature_space import feature_space
+
+    shots = _shots(config)
+    predictions = inputs.table("emulator_predictions")
+    predicted = {s: None if predictions is None else predictions[predictions["shot"].astype(str) == s] for s in shots}
+    return feature_space(inputs.per("features", shots), predicted, inputs.table("observed"), shots,
+                         config["observed"]["sd_fraction"], "emulator")
+
+
+def _features_hydrocode(inputs, config):
+    from shockcal.plots.feature_space import feature_space
+
+    shots = _shots(config)
+    return feature_space(inputs.per("features", shots), inputs.per("predicted_features", shots),
+                         inputs.table("observed"), shots, config["observed"]["sd_fraction"], "hydrocode")
+
+
+def _history(shot, inputs, config):
+    from shockcal.plots.feature_space import observed_row
+    from shockcal.plots.histories import estimate_time_shift, fig_history
+
+    measured = observed_row(inputs.table("observed"), shot)
+    aligned_to = inputs.table(f"predicted_features:{shot}")
+    if aligned_to is None:
+        aligned_to = inputs.table(f"features:{shot}")
+    return fig_history(shot, inputs.table(f"simulations:{shot}"), inputs.table(f"predicted_simulations:{shot}"),
+                       measured, inputs.record(shot), estimate_time_shift(measured, aligned_to),
+                       seed=config["study"]["seed"])
+
+
+def history_names(config) -> dict[str, str]:
+    """{figure name: shot} for Figs 11-13 (the first three shots of the config)."""
+    return {f"fig{11 + i}_history_{shot}": shot for i, shot in enumerate(_shots(config)[:3])}
+
+
+def catalogue(config) -> dict[str, FigureSpec]:
+    """Every figure of the study, in the paper's order (cheap: nothing is imported until a figure is built)."""
+    specs = [
+        FigureSpec("fig01_toy_calibration", "1 method", partial(_toy, "fig01_toy_calibration")),
+        FigureSpec("fig02_records", "2 data", _records),
+        FigureSpec("fig03_gp_draws", "1 method", partial(_toy, "fig03_gp_draws")),
+        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features")),
+        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split")),
+        FigureSpec("fig06_crossval", "3 emulator", _crossval),
+        FigureSpec("fig07_marginals", "4 posterior", _marginals),
+        FigureSpec("fig08_pairs", "4 posterior", _pairs),
+        FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator),
+        FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode),
+        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot))
+          for name, shot in history_names(config).items()),
+        FigureSpec("fig14_inadequate_model", "1 method", partial(_toy, "fig14_inadequate_model")),
+        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction")),
+    ]
+    return {spec.name: spec for spec in specs}
+
+
+def build_figure(name: str, inputs: FigureInputs, config: dict):
+    """Draw figure `name`; an unknown name is an InputError listing the known ones."""
+    specs = catalogue(config)
+    if name not in specs:
+        raise InputError(f"unknown figure '{name}'; known figures: {', '.join(specs)}")
+    return specs[name].build(inputs, config)

@@ -1,0 +1,79 @@
+"""Figures 9 and 10: the calibration features of each shot, training runs against posterior
+predictions (through the emulator for 9, through the hydrocode for 10) and the measurement.
+
+One row per shot, one column per calibration feature (elastic plateau, plastic plateau, slope
+points 1 and 2, all velocities in m/s): densities of the training runs (grey) and of the posterior
+predictions (blue), the measured value as a red line with its +-2 sd band (sd = observed.sd_fraction
+of the value, as in the likelihood).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from shockcal.plots.style import (CALIBRATION_FEATURES, COLORS, feature_label, figure_legend, no_data, note, styled,
+                                  subplots)
+
+
+def usable(features: pd.DataFrame | None) -> pd.DataFrame | None:
+    """Rows of a features table that did not fail (status column optional); None stays None."""
+    if features is None or "status" not in features.columns:
+        return features
+    return features[features["status"] != "failed"]
+
+
+def observed_row(observed: pd.DataFrame | None, shot: str) -> pd.Series | None:
+    """The measured features of `shot` from the observed table, or None."""
+    if observed is None or "shot" not in observed.columns:
+        return None
+    rows = observed[observed["shot"].astype(str) == shot]
+    return None if rows.empty else rows.iloc[0]
+
+
+def _panel(ax, column, training, predicted, measured, sd_fraction):
+    finite = [t[column].dropna().to_numpy(float) for t in (training, predicted) if t is not None and column in t.columns]
+    finite = [v for v in finite if v.size]
+    if measured is not None:
+        finite.append(np.array([measured * (1 - 3 * sd_fraction), measured * (1 + 3 * sd_fraction)]))
+    if not finite:
+        no_data(ax, f"no {column} values")
+        return
+    lo, hi = np.percentile(np.concatenate(finite), [0.5, 99.5])
+    bins = np.linspace(lo, hi + 1e-9, 31)
+    if training is not None and column in training.columns and training[column].notna().any():
+        ax.hist(training[column].dropna(), bins=bins, density=True, color=COLORS["training"], alpha=0.5, lw=0,
+                label="training runs")
+    if predicted is not None and column in predicted.columns and predicted[column].notna().any():
+        values = predicted[column].dropna()
+        ax.hist(values, bins=bins, density=True, color=COLORS["posterior"], alpha=0.25, lw=0)
+        ax.hist(values, bins=bins, density=True, histtype="step", color=COLORS["posterior"], lw=1.5,
+                label="posterior predictions")
+    if measured is not None:
+        sd = sd_fraction * abs(measured)
+        ax.axvspan(measured - 2 * sd, measured + 2 * sd, color=COLORS["measurement"], alpha=0.15, lw=0)
+        ax.axvline(measured, color=COLORS["measurement"], lw=1.8, label="measured ± 2 sd")
+    ax.set_yticks([])
+    ax.set_xlim(lo, hi)
+    ax.set_xlabel(feature_label(column))
+
+
+@styled
+def feature_space(training: dict, predicted: dict, observed: pd.DataFrame | None, shots: list[str],
+                  sd_fraction: float, source: str):
+    """Rows of shots, columns of calibration features; `source` names where predictions come from."""
+    cols = CALIBRATION_FEATURES
+    fig, axes = subplots(len(shots), len(cols), width=2.7 * len(cols), height=2.0 * len(shots) + 0.7)
+    for r, shot in enumerate(shots):
+        train, pred = usable(training.get(shot)), usable(predicted.get(shot))
+        measured = observed_row(observed, shot)
+        for c, column in enumerate(cols):
+            value = None if measured is None or column not in measured else float(measured[column])
+            _panel(axes[r, c], column, train, pred, value, sd_fraction)
+        axes[r, 0].set_ylabel(shot, fontsize=10, fontweight="bold")
+        missing = [what for what, table in (("training runs", train), (f"predictions ({source})", pred),
+                                            ("measurement", measured)) if table is None or len(table) == 0]
+        if missing:
+            note(axes[r, 0], "missing: " + ", ".join(missing))
+    figure_legend(fig, axes, title=f"posterior predictions through the {source}")
+    return fig

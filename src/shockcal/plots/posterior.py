@@ -1,0 +1,148 @@
+"""Posterior figures: 7 (marginals per calibration, rows, with Gray et al.'s sets) and 8 (joint pairs).
+
+Posterior tables hold one column per calibrated input in Table IV units (plus bookkeeping columns
+such as lambda_y, log_post, chain, which are ignored). Axes span the prior box in display units,
+widened where a reference value lies outside it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from shockcal.config import input_names
+from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots, to_display
+
+# Gray et al. Johnson-Cook fits for Al-5083 (SPEC section 3), display units (A, B in MPa).
+GRAY_SETS = {
+    "all rates, all T": {"A": 210.0, "B": 620.0, "C": 0.0125, "n": 0.375, "m": 1.525},
+    "high rate, all T": {"A": 200.0, "B": 600.0, "C": 0.0200, "n": 0.380, "m": 1.500},
+    "all rates, T > RT": {"A": 270.0, "B": 470.0, "C": 0.0105, "n": 0.600, "m": 1.200},
+    "high rate, T > RT": {"A": 170.0, "B": 425.0, "C": 0.0335, "n": 0.420, "m": 1.225},
+}
+GRAY_STYLES = ("-", "--", "-.", ":")
+N_BINS = 40
+
+
+def display_limits(name: str, config: dict) -> tuple[float, float]:
+    """Prior box of input `name` in display units, widened to show any of Gray's values outside it."""
+    box = config["inputs"][name]
+    lo, hi = to_display(name, [box["min"], box["max"]])
+    refs = [s[name] for s in GRAY_SETS.values() if name in s]
+    lo, hi = min([lo, *refs]), max([hi, *refs])
+    pad = 0.02 * (hi - lo)
+    return lo - pad, hi + pad
+
+
+def _shade_outside_box(ax, name: str, config: dict) -> None:
+    """Grey shading over the parts of the axis outside the prior box."""
+    box = config["inputs"][name]
+    lo, hi = to_display(name, [box["min"], box["max"]])
+    left, right = display_limits(name, config)
+    ax.axvspan(left, lo, color=COLORS["prior"], lw=0)
+    ax.axvspan(hi, right, color=COLORS["prior"], lw=0)
+
+
+def _gray_lines(ax, name: str) -> None:
+    for (label, values), ls in zip(GRAY_SETS.items(), GRAY_STYLES):
+        if name in values:
+            ax.axvline(values[name], color=COLORS["reference"], ls=ls, lw=1.1, label=f"Gray et al.: {label}")
+
+
+@styled
+def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
+    """Histograms of each input (columns) for each calibration (rows: shots, then joint).
+
+    `posteriors` maps a calibration name to its samples; None or an empty table gives a "no data" row.
+    """
+    names = input_names(config)
+    rows = list(posteriors)
+    fig, axes = subplots(len(rows), len(names), width=1.55 * len(names), height=1.35 * len(rows) + 0.9)
+    for r, calib in enumerate(rows):
+        samples = posteriors[calib]
+        for c, name in enumerate(names):
+            ax = axes[r, c]
+            if samples is None or samples.empty:
+                no_data(ax, "posterior missing" if samples is None else "posterior empty")
+            elif name not in samples.columns:
+                ax.set_yticks([])
+                ax.set_xticks([])
+                ax.text(0.5, 0.5, f"not an input\nof {calib}", transform=ax.transAxes, ha="center",
+                        va="center", fontsize=7, color="0.5")
+            else:
+                values = to_display(name, samples[name])
+                ax.hist(values, bins=N_BINS, range=display_limits(name, config), density=True,
+                        color=COLORS["posterior"], alpha=0.75, lw=0)
+                ax.set_xlim(display_limits(name, config))
+                ax.set_yticks([])
+                _shade_outside_box(ax, name, config)
+                _gray_lines(ax, name)
+            if r == len(rows) - 1:
+                ax.set_xlabel(input_label(name))
+            ax.tick_params(axis="x", labelsize=6.5)
+        axes[r, 0].set_ylabel(calib, fontsize=10, fontweight="bold")
+    figure_legend(fig, axes, title="posterior (blue); grey: outside the prior box")
+    return fig
+
+
+def _density_levels(hist, masses=(0.5, 0.9)):
+    """Density thresholds enclosing the given probability masses of a 2-D histogram (highest first)."""
+    flat = np.sort(hist.ravel())[::-1]
+    cum = np.cumsum(flat) / flat.sum()
+    levels = [flat[min(np.searchsorted(cum, m), len(flat) - 1)] for m in masses]
+    return sorted(set(levels))
+
+
+@styled
+def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
+    """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it."""
+    from scipy.ndimage import gaussian_filter
+
+    names = input_names(config)
+    k = len(names)
+    fig, axes = subplots(k, k, width=1.25 * k + 0.5, height=1.25 * k + 0.5)
+    if samples is None or samples.empty:
+        for ax in axes.flat:
+            ax.set_axis_off()
+        axes[k // 2, k // 2].set_axis_on()
+        no_data(axes[k // 2, k // 2], "joint posterior missing or empty")
+        return fig
+    missing = [n for n in names if n not in samples.columns]
+    values = {n: to_display(n, samples[n]) for n in names if n not in missing}
+    limits = {n: display_limits(n, config) for n in names}
+    for i, yname in enumerate(names):
+        for j, xname in enumerate(names):
+            ax = axes[i, j]
+            if j > i:
+                ax.set_axis_off()
+                continue
+            if xname in missing or yname in missing:
+                no_data(ax, f"{xname if xname in missing else yname} not in posterior")
+                continue
+            if i == j:
+                ax.hist(values[xname], bins=bins, range=limits[xname], density=True,
+                        color=COLORS["posterior"], alpha=0.75, lw=0)
+                ax.set_yticks([])
+            else:
+                hist, xe, ye = np.histogram2d(values[xname], values[yname], bins=bins,
+                                              range=[limits[xname], limits[yname]])
+                hist = gaussian_filter(hist, 1.0)
+                if hist.sum() > 0:
+                    xc, yc = 0.5 * (xe[1:] + xe[:-1]), 0.5 * (ye[1:] + ye[:-1])
+                    ax.contourf(xc, yc, hist.T, levels=[*_density_levels(hist), hist.max() + 1],
+                                colors=[COLORS["posterior"]], alpha=0.35)
+                    ax.contour(xc, yc, hist.T, levels=_density_levels(hist), colors=[COLORS["posterior"]],
+                               linewidths=0.8)
+                ax.set_ylim(limits[yname])
+            ax.set_xlim(limits[xname])
+            ax.tick_params(labelsize=6)
+            if i == k - 1:
+                ax.set_xlabel(input_label(xname), fontsize=7.5)
+            else:
+                ax.set_xticklabels([])
+            if j == 0 and i > 0:
+                ax.set_ylabel(input_label(yname), fontsize=7.5)
+            elif i != j:
+                ax.set_yticklabels([])
+    fig.suptitle(f"Joint posterior, {len(samples):,} samples: densities (diagonal), 50% and 90% regions")
+    return fig

@@ -1,0 +1,62 @@
+"""Posterior predictions: draws from the joint posterior as a design table for hydrocode runs, and
+emulator predictions of the calibration features at those draws.
+
+The drawn design has the training design's shape (`run`, then one column per input, Table IV
+units), so the workflow runs it through `shockcal simulate` and `shockcal features` unchanged.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from shockcal.config import input_names
+from shockcal.errors import InputError
+from shockcal.io import require_columns
+
+log = logging.getLogger(__name__)
+
+SEED_OFFSET = 7  # posterior draws use study.seed + SEED_OFFSET, apart from the other stages' streams
+
+
+def draw_posterior_design(posterior: pd.DataFrame, config: dict, n: int, seed: int,
+                          source: str = "posterior") -> pd.DataFrame:
+    """`n` rows drawn (seeded, without replacement when possible) from the posterior samples.
+
+    Returns a design table: `run` 0..n-1 and every config input. The posterior must hold every input
+    (a joint posterior); an empty table or a missing input is an InputError naming `source`.
+    """
+    names = input_names(config)
+    if posterior.empty:
+        raise InputError(f"{source}: posterior has no samples; cannot draw {n} posterior runs")
+    require_columns(posterior, names, source)
+    replace = len(posterior) < n
+    if replace:
+        log.warning("%s: only %d samples for %d posterior runs; drawing with replacement", source, len(posterior), n)
+    rows = np.random.default_rng(seed).choice(len(posterior), size=n, replace=replace)
+    design = posterior.iloc[np.sort(rows)][names].reset_index(drop=True).astype(float)
+    design.insert(0, "run", np.arange(n, dtype=np.int64))
+    return design
+
+
+def emulator_predictions(emulator, design: pd.DataFrame, shots: list[str]) -> pd.DataFrame:
+    """Emulator mean and sd (m/s) of the calibration features at every design row, for each shot.
+
+    One row per (run, shot): `run`, `shot`, the features (e.g. `v_elastic`, the predictive mean)
+    and their predictive sd (`v_elastic_sd`, emulator uncertainty, no observation error).
+    """
+    inputs = {name: design[name].to_numpy(float) for name in design.columns if name != "run"}
+    mean, cov = emulator.predict(inputs, shots)
+    sd = np.sqrt(np.clip(np.diagonal(cov, axis1=1, axis2=2), 0.0, None))
+    names = list(emulator.feature_names)
+    parts = []
+    for i, shot in enumerate(shots):
+        cols = slice(len(names) * i, len(names) * (i + 1))
+        part = pd.DataFrame(mean[:, cols], columns=names)
+        part[[f"{n}_sd" for n in names]] = sd[:, cols]
+        part.insert(0, "shot", shot)
+        part.insert(0, "run", design["run"].to_numpy())
+        parts.append(part)
+    return pd.concat(parts, ignore_index=True)

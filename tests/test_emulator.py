@@ -1,0 +1,134 @@
+"""PC-GP emulator: known functions, closed-form LOO, calibrated bands, file format, bad input."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shockcal.emulator import CALIBRATION_FEATURES, Emulator, fit_emulator, rmse_table
+from shockcal.errors import InputError
+from shockcal.gp import GaussianProcess
+
+NOISE = 0.05
+
+
+def known_function(x):
+    """A smooth 3-input, 4-output map (m/s-like scale)."""
+    a, b, c = x.T
+    return np.column_stack([60 + 20 * a + 5 * np.sin(3 * b), 200 + 10 * a * b, 80 + 15 * np.cos(2 * c) + 8 * a,
+                            190 + 12 * b + 4 * c**2])
+
+
+def test_gp_recovers_a_known_function_with_loo_error_near_the_noise():
+    rng = np.random.default_rng(1)
+    x = rng.uniform(size=(80, 3))
+    y = np.sin(3 * x[:, 0]) + x[:, 1] ** 2 + NOISE * rng.normal(size=80)
+    gp = GaussianProcess.fit(x, y, n_starts=2)
+    mean, var = gp.loo()
+    rmse = np.sqrt(np.mean((mean - y) ** 2))
+    assert rmse < 1.5 * NOISE
+    inside = np.abs(mean - y) <= 1.6449 * np.sqrt(var)
+    assert 0.8 <= inside.mean() <= 0.98
+
+
+def test_closed_form_loo_equals_brute_force_refitting():
+    rng = np.random.default_rng(2)
+    x = rng.uniform(size=(25, 3))
+    y = np.cos(2 * x[:, 0]) * x[:, 2] + 0.01 * rng.normal(size=25)
+    gp = GaussianProcess.fit(x, y, n_starts=1)
+    loo_mean, loo_var = gp.loo()
+    for i in range(25):
+        keep = np.arange(25) != i
+        mean, var = GaussianProcess(x[keep], y[keep], gp.hyper).predict(x[i:i + 1])
+        assert mean[0] == pytest.approx(loo_mean[i], abs=1e-8)
+        assert var[0] == pytest.approx(loo_var[i], abs=1e-8)
+
+
+def _synthetic_study(paper_config, n=60, seed=3):
+    """A design over the paper's box whose 104S features are a known function of A, B, n."""
+    from shockcal.design import latin_hypercube
+
+    design = latin_hypercube(paper_config, n, seed)
+    lo = np.array([paper_config["inputs"][k]["min"] for k in ("A", "B", "n")])
+    hi = np.array([paper_config["inputs"][k]["max"] for k in ("A", "B", "n")])
+    x = (design[["A", "B", "n"]].to_numpy() - lo) / (hi - lo)
+    rng = np.random.default_rng(seed)
+    y = known_function(x) + NOISE * rng.normal(size=(n, 4))
+    features = pd.DataFrame(y, columns=CALIBRATION_FEATURES).assign(run=design["run"], status="ok")
+    return design, features, x
+
+
+def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
+    design, features, _ = _synthetic_study(paper_config, n=90)
+    paper_config["emulator"].update(structure="per_shot", n_starts=2)
+    emulator = fit_emulator(paper_config, design, {"104S": features})
+    table = rmse_table(emulator.cv_table())
+    overall = table.iloc[-1]
+    assert overall["rmse_m_s"] < 3 * NOISE
+    assert 0.8 <= overall["coverage90"] <= 0.98
+    new, _, x_new = _synthetic_study(paper_config, n=20, seed=9)
+    mean, cov = emulator.predict({k: new[k].to_numpy() for k in new.columns}, ["104S"])
+    assert mean.shape == (20, 4) and cov.shape == (20, 4, 4)
+    assert np.sqrt(np.mean((mean - known_function(x_new)) ** 2)) < 4 * NOISE
+    assert np.all(np.linalg.eigvalsh(cov) > 0)
+
+
+def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path, paper_config):
+    design, features, _ = _synthetic_study(paper_config, n=30)
+    paper_config["emulator"].update(n_starts=1)
+    emulator = fit_emulator(paper_config, design, {"104S": features, "106S": features})
+    loaded = Emulator.load(emulator.save(tmp_path / "emu"))
+    inputs = {k: design[k].to_numpy()[:5] for k in design.columns}
+    for a, b in zip(emulator.predict(inputs, ["106S", "104S"]), loaded.predict(inputs, ["106S", "104S"])):
+        np.testing.assert_array_equal(a, b)
+    assert loaded.required_inputs(["106S"]) == ["A", "B", "C", "n", "m", "V3", "G1", "Delta2", "Delta3"]
+    meta = json.loads((tmp_path / "emu" / "emulator.json").read_text())
+    meta["version"] = 99
+    (tmp_path / "emu" / "emulator.json").write_text(json.dumps(meta))
+    with pytest.raises(InputError, match="version 99"):
+        Emulator.load(tmp_path / "emu")
+    with pytest.raises(InputError, match=r"no shot \['105S'\]"):
+        loaded.predict(inputs, ["105S"])
+
+
+def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
+    caplog.set_level("INFO", logger="shockcal.emulator")
+    design, features, _ = _synthetic_study(paper_config, n=30)
+    features.loc[0, "status"] = "failed"
+    features.loc[1, "v_plastic"] = np.nan
+    paper_config["emulator"].update(n_starts=1)
+    emulator = fit_emulator(paper_config, design, {"104S": features})
+    assert len(emulator.blocks[0].runs) == 28
+    assert "2 of 30 runs dropped" in caplog.text
+
+
+@pytest.mark.parametrize("mutate, message", [
+    (lambda d, f: (d, f.iloc[:8]), "at least 9"),
+    (lambda d, f: (d.assign(C=0.01), f), "input C is constant"),
+    (lambda d, f: (d, f.assign(run=f["run"] + 1000)), "not in the design"),
+    (lambda d, f: (d.assign(A=d["A"] * 3), f), "outside the prior box"),
+])
+def test_bad_training_sets_are_rejected(paper_config, mutate, message):
+    design, features = mutate(*_synthetic_study(paper_config, n=30)[:2])
+    with pytest.raises(InputError, match=message):
+        fit_emulator(paper_config, design, {"104S": features})
+
+
+def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
+    from shockcal.cli import main
+
+    design, features, _ = _synthetic_study(paper_config, n=30)
+    design.to_csv(tmp_path / "design.csv", index=False)
+    features.to_parquet(tmp_path / "f.parquet")
+    quick = tmp_path / "c.yaml"
+    import yaml
+    paper_config["emulator"]["n_starts"] = 1
+    quick.write_text(yaml.safe_dump(paper_config))
+    assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
+                 "--features", f"104S={tmp_path / 'f.parquet'}", "--out", str(tmp_path / "emu")]) == 0
+    cv = pd.read_parquet(tmp_path / "emu" / "cv.parquet")
+    assert set(cv.columns) == {"run", "shot", "feature", "simulated", "predicted", "predicted_sd"}
+    assert len(cv) == 30 * 4
+    assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
+                 "--features", "104S", "--out", str(tmp_path / "x")]) == 2
