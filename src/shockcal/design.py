@@ -94,3 +94,25 @@ def validate_shot_parameters(design: pd.DataFrame, config: dict, shot: str, sour
         if bad.any():
             row = design.loc[bad, "run"].iloc[0]
             raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {shot}")
+
+
+def planned_design(config: dict) -> pd.DataFrame:
+    """The study's design as `shockcal design` writes it: the config's design file, or its LHS."""
+    if config["design"]["file"]:
+        return load_design(config["design"]["file"], config)
+    return latin_hypercube(config, config["design"]["n_runs"], config["study"]["seed"])
+
+
+def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:
+    """A content digest of each chunk of `chunk_size` design rows.
+
+    The workflow puts these in each simulate job's params, so a chunk reruns exactly when its own
+    rows change: appending runs to a design file adds chunks without touching finished ones.
+    """
+    import hashlib
+
+    digests = []
+    for start in range(0, len(design), chunk_size):
+        rows = design.iloc[start:start + chunk_size]
+        digests.append(hashlib.sha256(pd.util.hash_pandas_object(rows, index=False).to_numpy().tobytes()).hexdigest()[:16])
+    return digests

@@ -1,1 +1,59 @@
-# calibrate rules (see docs/workflow.md)
+# Calibrate: single-shot posteriors, the joint posterior, and the synthetic-truth coverage check.
+
+CALIBRATIONS = [*SHOTS, "joint"]
+
+
+def calibration_shots(wildcards):
+    return " ".join(SHOTS if wildcards.name == "joint" else [wildcards.name])
+
+
+rule calibrate:
+    input:
+        emulator=f"{RESULTS}/emulator/emulator.json",
+        observed=f"{RESULTS}/features/observed.parquet",
+    output:
+        samples=f"{RESULTS}/posterior/{{name}}.parquet",
+        summary=f"{RESULTS}/posterior/{{name}}_summary.parquet",
+    wildcard_constraints:
+        name="|".join(CALIBRATIONS),
+    params:
+        calibration=config["calibration"],
+        sd_fraction=config["observed"]["sd_fraction"],
+        seed=config["study"]["seed"],
+        shots=calibration_shots,
+        emulator_dir=f"{RESULTS}/emulator",
+    log:
+        log_file("calibrate/{name}"),
+    benchmark:
+        benchmark_file("calibrate/{name}")
+    conda:
+        "../envs/shockcal.yaml"
+    shell:
+        "shockcal calibrate --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {params.shots}"
+        " --observed {input.observed} --out {output.samples} --summary {output.summary} > {log} 2>&1"
+
+
+rule calibration_check:
+    input:
+        emulator=f"{RESULTS}/emulator/emulator.json",
+    output:
+        coverage=f"{RESULTS}/posterior/coverage.parquet",
+        trials=f"{RESULTS}/posterior/coverage_trials.parquet",
+    params:
+        calibration=config["calibration"],
+        sd_fraction=config["observed"]["sd_fraction"],
+        seed=config["study"]["seed"],
+        emulator_dir=f"{RESULTS}/emulator",
+    log:
+        log_file("calibrate/coverage"),
+    benchmark:
+        benchmark_file("calibrate/coverage")
+    conda:
+        "../envs/shockcal.yaml"
+    shell:
+        "shockcal calibrate-check --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {SHOTS}"
+        " --out {output.coverage} > {log} 2>&1"
+
+
+ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)
+ALL_TARGETS.append(f"{RESULTS}/posterior/coverage.parquet")

@@ -1,1 +1,43 @@
-# features rules (see docs/workflow.md)
+# Features: per shot from all its simulation chunks; observed features from the config or records.
+
+
+rule features:
+    input:
+        expand(f"{RESULTS}/simulations/{{{{shot}}}}/chunk-{{chunk}}.parquet", chunk=CHUNKS),
+    output:
+        f"{RESULTS}/features/{{shot}}.parquet",
+    params:
+        features=config["features"],
+        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
+        max_failed_fraction=config["simulate"]["max_failed_fraction"],
+    log:
+        log_file("features/{shot}"),
+    benchmark:
+        benchmark_file("features/{shot}")
+    conda:
+        "../envs/shockcal.yaml"
+    shell:
+        "shockcal features --config {EFFECTIVE_CONFIG} --shot {wildcards.shot} --traces {input} --out {output} > {log} 2>&1"
+
+
+rule observed:
+    input:
+        [record["path"] for record in config["observed"]["records"].values()],
+    output:
+        f"{RESULTS}/features/observed.parquet",
+    params:
+        observed=config["observed"],
+        features=config["features"],
+        analysis={shot: spec.get("analysis", {}) for shot, spec in config["shots"].items()},
+    log:
+        log_file("observed"),
+    benchmark:
+        benchmark_file("observed")
+    conda:
+        "../envs/shockcal.yaml"
+    shell:
+        "shockcal observed --config {EFFECTIVE_CONFIG} --out {output} > {log} 2>&1"
+
+
+ALL_TARGETS += expand(f"{RESULTS}/features/{{shot}}.parquet", shot=SHOTS)
+ALL_TARGETS.append(f"{RESULTS}/features/observed.parquet")

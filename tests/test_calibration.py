@@ -1,0 +1,116 @@
+# NOTE from the lead: read /work/main/.notes/calibration.md (this file predates your sample() signature).
+"""Calibration: the sampler against closed-form and two-mode posteriors, diagnostics, bad input."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from shockcal.calibration import LAMBDA_Y_PRIOR, Problem, calibrate, observed_vector, sample
+from shockcal.diagnostics import ess_bulk, split_rhat
+from shockcal.errors import InputError
+
+
+class StandInEmulator:
+    """An 'emulator' with a known mean function and a constant predictive covariance."""
+
+    feature_names = ["v_elastic", "v_plastic"]
+
+    def __init__(self, mean_fn, names, lower, upper, cov):
+        self.mean_fn, self.names = mean_fn, names
+        self.lower, self.upper, self.cov = np.array(lower, float), np.array(upper, float), np.asarray(cov, float)
+
+    def required_inputs(self, shots):
+        return self.names
+
+    def input_bounds(self, names):
+        return self.lower, self.upper
+
+    def predict(self, inputs, shots):
+        theta = np.column_stack([inputs[k] for k in self.names])
+        return self.mean_fn(theta), np.broadcast_to(self.cov, (len(theta), *self.cov.shape)).copy()
+
+
+def _posterior_on_grid(problem, grids):
+    """Unnormalised posterior on a grid over (theta..., log lambda_y), by brute force."""
+    mesh = np.meshgrid(*grids, indexing="ij")
+    points = np.column_stack([m.ravel() for m in mesh])
+    logp = np.concatenate([problem.log_posterior(chunk) for chunk in np.array_split(points, 50)])
+    weights = np.exp(logp - logp.max())
+    return points, weights / weights.sum()
+
+
+def _observed(y):
+    return pd.DataFrame([{"shot": "S", "v_elastic": y[0], "v_plastic": y[1]}])
+
+
+def test_linear_gaussian_posterior_mean_and_variance_match_the_exact_answer():
+    H = np.array([[30.0, 5.0], [-4.0, 40.0]])
+    emulator = StandInEmulator(lambda t: 100.0 + t @ H.T, ["a", "b"], [-1, -1], [1, 1], 0.25 * np.eye(2))
+    problem = Problem.build(emulator, ["S"], _observed([106.0, 108.0]), 0.01)
+    samples, _ = sample(problem, 40000, 32, 400, 1, 0.1, seed=5)
+    points, weights = _posterior_on_grid(problem, [np.linspace(-0.2, 0.6, 121), np.linspace(-0.2, 0.6, 121),
+                                                   np.linspace(-3.0, 2.5, 80)])
+    for i, name in enumerate(["a", "b"]):
+        exact_mean = weights @ points[:, i]
+        exact_sd = np.sqrt(weights @ (points[:, i] - exact_mean) ** 2)
+        draws = samples[name].to_numpy().reshape(32, -1)
+        mc_error = draws.std() / np.sqrt(ess_bulk(draws))
+        assert abs(draws.mean() - exact_mean) < 4 * mc_error + 1e-3
+        assert draws.std() == pytest.approx(exact_sd, rel=0.05)
+        assert split_rhat(draws) < 1.05
+
+
+def test_two_mode_posterior_is_found_in_the_right_proportion():
+    # feature depends on theta^2 (two modes at +-0.6) with a small odd term tilting their masses
+    emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2 + 1.5 * t[:, 0],
+                                                          80 + 20 * t[:, 0] ** 2]),
+                               ["a"], [-1], [1], 0.01 * np.eye(2))
+    problem = Problem.build(emulator, ["S"], _observed([118.0, 87.2]), 0.01)
+    samples, _ = sample(problem, 60000, 32, 500, 1, 0.1, seed=7)
+    points, weights = _posterior_on_grid(problem, [np.linspace(-1, 1, 2001), np.linspace(-3.0, 2.5, 120)])
+    exact_positive = weights[points[:, 0] > 0].sum()
+    assert 0.2 < exact_positive < 0.8 and abs(exact_positive - 0.5) > 0.05  # both modes matter, unequally
+    assert (samples["a"] > 0).mean() == pytest.approx(exact_positive, abs=0.04)
+    assert samples["a"].abs().median() == pytest.approx(0.6, abs=0.05)
+
+
+def test_lambda_y_prior_is_recovered_when_the_data_say_nothing():
+    emulator = StandInEmulator(lambda t: np.column_stack([100 + 0 * t[:, 0], 80 + 0 * t[:, 0]]),
+                               ["a"], [0], [1], 1e6 * np.eye(2))  # emulator so uncertain that y is uninformative
+    problem = Problem.build(emulator, ["S"], _observed([100.0, 80.0]), 0.01)
+    samples, _ = sample(problem, 30000, 32, 300, 1, 0.1, seed=3)
+    prior = stats.gamma(LAMBDA_Y_PRIOR[0], scale=1 / LAMBDA_Y_PRIOR[1])
+    assert samples["lambda_y"].mean() == pytest.approx(prior.mean(), rel=0.06)
+    assert samples["a"].mean() == pytest.approx(0.5, abs=0.03)
+
+
+def test_same_seed_gives_identical_samples():
+    emulator = StandInEmulator(lambda t: 100.0 + 10 * t, ["a", "b"], [0, 0], [1, 1], np.eye(2))
+    problem = Problem.build(emulator, ["S"], _observed([105.0, 104.0]), 0.01)
+    a, _ = sample(problem, 2000, 16, 50, 1, 0.1, seed=1)
+    b, _ = sample(problem, 2000, 16, 50, 1, 0.1, seed=1)
+    pd.testing.assert_frame_equal(a, b)
+
+
+@pytest.mark.parametrize("table, message", [
+    (pd.DataFrame([{"shot": "T", "v_elastic": 1.0, "v_plastic": 2.0}]), "no observed features for shot S"),
+    (pd.DataFrame([{"shot": "S", "v_elastic": -1.0, "v_plastic": 2.0}]), r"\['v_elastic'\] missing or not positive"),
+    (pd.DataFrame([{"shot": "S", "v_elastic": np.nan, "v_plastic": 2.0}]), "missing or not positive"),
+    (pd.DataFrame([{"shot": "S", "v_elastic": 1.0}]), "missing column"),
+])
+def test_bad_observed_features_are_rejected(table, message):
+    with pytest.raises(InputError, match=message):
+        observed_vector(table, ["S"], ["v_elastic", "v_plastic"], "obs.csv")
+
+
+def test_summary_flags_chains_that_have_not_mixed(paper_config, caplog):
+    emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2, 80 + 20 * t[:, 0] ** 2]),
+                               ["A"], [-1], [1], 0.01 * np.eye(2))
+    paper_config["inputs"]["A"] = {"min": -1, "max": 1, "unit": "Mbar"}
+    paper_config["calibration"].update(walkers=16, burn_in_steps=0, mode_hop_fraction=0.0)
+    samples, summary, info = calibrate(emulator, ["S"], _observed([118.0, 87.2]), paper_config, n_samples=800)
+    row = summary.set_index("parameter").loc["A"]
+    assert row["r_hat"] > 1.05 and not row["converged"]
+    assert "has not mixed" in caplog.text or "have not mixed" in caplog.text
+    assert info["parameters"] == ["A"] and set(samples.columns) >= {"A", "lambda_y", "log_post", "chain", "step"}
