@@ -1,0 +1,50 @@
+"""`shockcal simulate`: run design rows through the hydrocode for one shot into a Parquet table."""
+
+from __future__ import annotations
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("simulate", help="run design rows through the hydrocode for one shot")
+    p.add_argument("--config", required=True, help="study config YAML")
+    p.add_argument("--shot", required=True, help="shot name in the config, e.g. 104S")
+    p.add_argument("--design", required=True, help="design table (CSV or Parquet; Table IV units; `run` kept)")
+    p.add_argument("--rows", default=":", help="slice of design row positions, e.g. 0:25 (default: all)")
+    p.add_argument("--out", required=True, help="output Parquet table (one row per run; see docs/hydro.md)")
+    p.set_defaults(func=run)
+
+
+def parse_rows(text: str) -> slice:
+    from shockcal.errors import InputError
+
+    parts = text.split(":")
+    if len(parts) != 2:
+        raise InputError(f"--rows: '{text}' is not START:STOP")
+    try:
+        start, stop = (int(p) if p else None for p in parts)
+    except ValueError:
+        raise InputError(f"--rows: '{text}' is not START:STOP with integers") from None
+    return slice(start, stop)
+
+
+def run(args) -> int:
+    import logging
+
+    from shockcal.config import load_config, shot_config, shot_inputs
+    from shockcal.design import load_design, validate_shot_parameters
+    from shockcal.io import write_table
+    from shockcal.simulate import UNITS, simulate_design
+
+    config = load_config(args.config)
+    shot_config(config, args.shot)
+    rows = parse_rows(args.rows)
+    design = load_design(args.design, config, columns=shot_inputs(config, args.shot)).iloc[rows]
+    validate_shot_parameters(design, config, args.shot, args.design)
+    table = simulate_design(design, config, args.shot)
+    units = {**UNITS, **{k: config["inputs"][k]["unit"] for k in shot_inputs(config, args.shot)}}
+    write_table(table, args.out, {"table": "simulations", "shot": args.shot, "units": units,
+                                  "hydro": config["hydro"], "material": config["material"]})
+    failed = int((table["status"] != "ok").sum()) if len(table) else 0
+    logging.getLogger("shockcal.simulate").info("shot %s: %d runs, %d failed, %.1f s of hydrocode -> %s", args.shot,
+                                                len(table), failed, table["wall_time_s"].sum() if len(table) else 0.0,
+                                                args.out)
+    return 0

@@ -1,0 +1,55 @@
+"""Run a design through the hydrocode for one shot, one table row per run.
+
+A run that fails numerically, or raises, is recorded with status "failed" and a reason; the batch
+always continues. Columns of the simulations table (see docs/hydro.md):
+run, shot, the shot's design inputs (Table IV units), impact_velocity_m_s, shear_modulus_GPa,
+status, reason, max_strain_rate_per_us, max_temperature_K, max_plastic_strain, energy_error,
+n_steps, wall_time_s, t_us (list, microseconds), v_m_s (list, free-surface velocity in m/s).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from shockcal.config import shot_config, shot_inputs
+from shockcal.design import shot_parameters
+from shockcal.hydro import run_shot
+
+log = logging.getLogger("shockcal.simulate")
+MBAR_TO_GPA = 100.0
+CM_US_TO_M_S = 1.0e4
+DIAGNOSTICS = ["max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
+               "n_steps", "wall_time_s"]
+UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_rate_per_us": "1/us",
+         "max_temperature_K": "K", "max_plastic_strain": "-", "energy_error": "relative", "wall_time_s": "s",
+         "t_us": "us", "v_m_s": "m/s"}
+
+
+def simulate_design(design: pd.DataFrame, config: dict, shot: str) -> pd.DataFrame:
+    """Simulate every row of `design` for `shot`; failures become rows with a reason."""
+    spec = shot_config(config, shot)
+    inputs = shot_inputs(config, shot)
+    rows = []
+    for record in design.to_dict("records"):
+        params = shot_parameters(record, config, shot)
+        row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
+               "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
+               "shear_modulus_GPa": params.shear_modulus_Mbar * MBAR_TO_GPA}
+        try:
+            result = run_shot(params, spec, config)
+        except Exception as exc:  # a run must never kill the batch; the reason is kept
+            log.exception("run %s of shot %s raised", row["run"], shot)
+            rows.append({**row, "status": "failed", "reason": f"{type(exc).__name__}: {exc}",
+                         **{k: np.nan for k in DIAGNOSTICS}, "t_us": [], "v_m_s": []})
+            continue
+        if result.status != "ok":
+            log.warning("run %s of shot %s failed: %s", row["run"], shot, result.reason)
+        rows.append({**row, "status": result.status, "reason": result.reason,
+                     **{k: getattr(result, k) for k in DIAGNOSTICS},
+                     "t_us": result.t_us, "v_m_s": result.v_m_s})
+    table = pd.DataFrame(rows)
+    table["n_steps"] = table["n_steps"].astype("Int64")
+    return table
