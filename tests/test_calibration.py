@@ -1,4 +1,3 @@
-# NOTE from the lead: read /work/main/.notes/calibration.md (this file predates your sample() signature).
 """Calibration: the sampler against closed-form and two-mode posteriors, diagnostics, bad input."""
 
 import numpy as np
@@ -40,6 +39,11 @@ def _posterior_on_grid(problem, grids):
     return points, weights / weights.sum()
 
 
+def _sample(problem, n_samples, walkers, burn_in_steps, mode_hop_fraction, seed):
+    settings = {"walkers": walkers, "burn_in_steps": burn_in_steps, "thin": 1, "mode_hop_fraction": mode_hop_fraction}
+    return sample(problem, n_samples, settings, seed)
+
+
 def _observed(y):
     return pd.DataFrame([{"shot": "S", "v_elastic": y[0], "v_plastic": y[1]}])
 
@@ -48,7 +52,7 @@ def test_linear_gaussian_posterior_mean_and_variance_match_the_exact_answer():
     H = np.array([[30.0, 5.0], [-4.0, 40.0]])
     emulator = StandInEmulator(lambda t: 100.0 + t @ H.T, ["a", "b"], [-1, -1], [1, 1], 0.25 * np.eye(2))
     problem = Problem.build(emulator, ["S"], _observed([106.0, 108.0]), 0.01)
-    samples, _ = sample(problem, 40000, 32, 400, 1, 0.1, seed=5)
+    samples, _ = _sample(problem, 40000, 32, 400, 0.1, seed=5)
     points, weights = _posterior_on_grid(problem, [np.linspace(-0.2, 0.6, 121), np.linspace(-0.2, 0.6, 121),
                                                    np.linspace(-3.0, 2.5, 80)])
     for i, name in enumerate(["a", "b"]):
@@ -62,12 +66,12 @@ def test_linear_gaussian_posterior_mean_and_variance_match_the_exact_answer():
 
 
 def test_two_mode_posterior_is_found_in_the_right_proportion():
-    # feature depends on theta^2 (two modes at +-0.6) with a small odd term tilting their masses
-    emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2 + 1.5 * t[:, 0],
+    # feature depends on theta^2 (modes near +0.55 and -0.65); the second feature favours one of them
+    emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2 + 5.0 * t[:, 0],
                                                           80 + 20 * t[:, 0] ** 2]),
                                ["a"], [-1], [1], 0.01 * np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([118.0, 87.2]), 0.01)
-    samples, _ = sample(problem, 60000, 32, 500, 1, 0.1, seed=7)
+    problem = Problem.build(emulator, ["S"], _observed([118.0, 87.0]), 0.01)
+    samples, _ = _sample(problem, 60000, 32, 500, 0.1, seed=7)
     points, weights = _posterior_on_grid(problem, [np.linspace(-1, 1, 2001), np.linspace(-3.0, 2.5, 120)])
     exact_positive = weights[points[:, 0] > 0].sum()
     assert 0.2 < exact_positive < 0.8 and abs(exact_positive - 0.5) > 0.05  # both modes matter, unequally
@@ -79,7 +83,7 @@ def test_lambda_y_prior_is_recovered_when_the_data_say_nothing():
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 0 * t[:, 0], 80 + 0 * t[:, 0]]),
                                ["a"], [0], [1], 1e6 * np.eye(2))  # emulator so uncertain that y is uninformative
     problem = Problem.build(emulator, ["S"], _observed([100.0, 80.0]), 0.01)
-    samples, _ = sample(problem, 30000, 32, 300, 1, 0.1, seed=3)
+    samples, _ = _sample(problem, 30000, 32, 300, 0.1, seed=3)
     prior = stats.gamma(LAMBDA_Y_PRIOR[0], scale=1 / LAMBDA_Y_PRIOR[1])
     assert samples["lambda_y"].mean() == pytest.approx(prior.mean(), rel=0.06)
     assert samples["a"].mean() == pytest.approx(0.5, abs=0.03)
@@ -88,8 +92,8 @@ def test_lambda_y_prior_is_recovered_when_the_data_say_nothing():
 def test_same_seed_gives_identical_samples():
     emulator = StandInEmulator(lambda t: 100.0 + 10 * t, ["a", "b"], [0, 0], [1, 1], np.eye(2))
     problem = Problem.build(emulator, ["S"], _observed([105.0, 104.0]), 0.01)
-    a, _ = sample(problem, 2000, 16, 50, 1, 0.1, seed=1)
-    b, _ = sample(problem, 2000, 16, 50, 1, 0.1, seed=1)
+    a, _ = _sample(problem, 2000, 16, 50, 0.1, seed=1)
+    b, _ = _sample(problem, 2000, 16, 50, 0.1, seed=1)
     pd.testing.assert_frame_equal(a, b)
 
 

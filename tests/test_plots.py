@@ -18,7 +18,8 @@ SHOTS = ["104S", "105S", "106S"]
 
 
 def _texts(fig) -> str:
-    return " ".join(t.get_text() for ax in fig.axes for t in ax.texts)
+    """All text written in the panels and their titles."""
+    return " ".join([t.get_text() for ax in fig.axes for t in ax.texts] + [ax.get_title() for ax in fig.axes])
 
 
 def _save_png(fig, tmp_path, name="fig"):

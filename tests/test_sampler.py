@@ -48,3 +48,14 @@ def test_two_modes_found_in_the_right_proportion():
     per_walker = upper.mean(axis=1)
     assert abs(share - 0.7) < 0.04
     assert np.all((per_walker > 0.3) & (per_walker < 0.95)), "walkers must hop between modes, not stay put"
+
+
+def test_stranded_walkers_restart_from_the_others():
+    from shockcal.sampler import restart_lost_walkers
+
+    coords = np.arange(20.0)[:, None] * np.ones((1, 2))
+    log_prob = -np.linspace(0, 2, 20)
+    log_prob[[3, 7]] = -80.0
+    moved = restart_lost_walkers(coords, log_prob, np.random.default_rng(0))
+    assert set(np.flatnonzero(np.any(moved != coords, axis=1))) == {3, 7}
+    assert np.all(np.min(np.abs(moved[[3, 7], None, 0] - np.delete(coords, [3, 7], 0)[None, :, 0]), axis=1) < 0.1)

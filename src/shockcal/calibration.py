@@ -149,70 +149,56 @@ def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str
 
 
 def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, **overrides) -> pd.DataFrame:
-    """Coverage check: per trial draw theta uniformly on the box, y from the emulator plus 1% noise, calibrate.
+    """Calibrate on synthetic truth drawn from the model itself; one row per trial and parameter.
 
-    y ~ N(eta(theta), C_eta(theta) + diag(sd_fraction * eta)^2), i.e. the likelihood's model at
-    lambda_y = 1. Returns one row per trial and parameter: truth, q05, q95, inside (90% interval).
+    Each trial draws theta uniformly on the box and lambda_y from its prior, features from the
+    emulator's predictive distribution at theta plus observation noise of sd = sd_fraction /
+    sqrt(lambda_y) of each feature, and calibrates (`overrides` as in `calibrate`). Columns:
+    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), r_hat.
     """
     rng = np.random.default_rng(seed)
     names = emulator.required_inputs(shots)
     lower, upper = emulator.input_bounds(names)
-    features = emulator.feature_names
+    sd_fraction = config["observed"]["sd_fraction"]
     rows = []
     for trial in range(trials):
-        truth = rng.uniform(lower, upper)
-        mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, truth)}, shots)
-        noise_cov = cov[0] + np.diag((config["observed"]["sd_fraction"] * mean[0]) ** 2)
-        y = rng.multivariate_normal(mean[0], noise_cov).reshape(len(shots), len(features))
-        observed = pd.DataFrame(y, columns=features).assign(shot=list(shots))
+        theta, lam, y = _synthetic_features(emulator, shots, names, lower, upper, sd_fraction, rng)
+        observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
         _, summary, _ = calibrate(emulator, shots, observed, config, source=f"synthetic trial {trial}",
-                                  seed=seed + 1 + trial, **overrides)
-        summary = summary.set_index("parameter").loc[names]
-        for name, value in zip(names, truth):
+                                  seed=int(rng.integers(2**31)), **overrides)
+        summary = summary.set_index("parameter")
+        for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
             q05, q95 = summary.loc[name, ["q05", "q95"]]
-            rows.append({"trial": trial, "parameter": name, "truth": value, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= value <= q95), "r_hat": summary.loc[name, "r_hat"]})
-        log.info("synthetic trial %d/%d: %d of %d parameters inside their 90%% interval", trial + 1, trials,
-                 sum(r["inside"] for r in rows[-len(names):]), len(names))
+            rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
+                         "inside": bool(q05 <= truth <= q95), "r_hat": summary.loc[name, "r_hat"]})
+        log.info("synthetic trial %d/%d done", trial + 1, trials)
     return pd.DataFrame(rows)
 
 
-def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
-    """Per parameter: trials, share of 90% intervals holding the truth, largest R-hat."""
-    return trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
-                                                       max_r_hat=("r_hat", "max")).reset_index()
-
-
-def coverage_check(emulator, shots, config: dict, trials: int | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Calibrate on synthetic truth drawn from the model itself; count 90% intervals holding the truth.
-
-    Each trial draws theta uniformly on the box and lambda_y from its prior, features from the
-    emulator's predictive distribution at theta, plus observation noise of sd = sd_fraction /
-    sqrt(lambda_y) of each feature, and calibrates. Returns the per-trial table and the coverage
-    per parameter (nominal 0.90).
-    """
-    settings = config["calibration"]
-    check = settings["check"]
-    trials = trials or check["trials"]
-    sd_fraction = config["observed"]["sd_fraction"]
-    names = emulator.required_inputs(shots)
-    lower, upper = emulator.input_bounds(names)
-    rng = np.random.default_rng(config["study"]["seed"] + settings["seed_offset"] + 1)
-    rows = []
-    for trial in range(trials):
+def _synthetic_features(emulator, shots, names, lower, upper, sd_fraction, rng):
+    """(theta, lambda_y, y) drawn from prior and model; draws with a non-positive feature (no
+    measurement would report one) are redrawn."""
+    while True:
         theta = rng.uniform(lower, upper)
         lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1])
         mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
         eta = rng.multivariate_normal(mean[0], cov[0])
         y = eta + sd_fraction * np.abs(eta) / np.sqrt(lam) * rng.normal(size=eta.shape)
-        problem = Problem(emulator, list(shots), y, sd_fraction * np.abs(y), names, lower, upper)
-        samples, _ = sample(problem, check["n_samples"], settings["walkers"], check["burn_in_steps"], 1,
-                            settings["mode_hop_fraction"], seed=int(rng.integers(2**31)))
-        for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
-            q05, q95 = np.quantile(samples[name], [0.05, 0.95])
-            rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= truth <= q95)})
-        log.info("coverage trial %d/%d done", trial + 1, trials)
-    table = pd.DataFrame(rows)
-    coverage = table.groupby("parameter", sort=False)["inside"].agg(coverage90="mean", trials="size").reset_index()
-    return table, coverage
+        if np.all(y > 0):
+            return theta, lam, y
+        log.info("synthetic draw with a non-positive feature at %s: redrawn", dict(zip(names, theta.round(5))))
+
+
+def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
+    """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), largest R-hat."""
+    return trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
+                                                       max_r_hat=("r_hat", "max")).reset_index()
+
+
+def coverage_check(emulator, shots, config: dict, trials: int | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The configured synthetic-truth check (calibration.check): per-trial table and coverage per parameter."""
+    settings, check = config["calibration"], config["calibration"]["check"]
+    table = synthetic_truth(emulator, shots, config, trials or check["trials"],
+                            seed=config["study"]["seed"] + settings["seed_offset"] + 1,
+                            n_samples=check["n_samples"], burn_in_steps=check["burn_in_steps"])
+    return table, coverage_table(table)

@@ -30,15 +30,14 @@ rule calibrate:
         "../envs/shockcal.yaml"
     shell:
         "shockcal calibrate --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {params.shots}"
-        " --observed {input.observed} --out {output.samples} --summary {output.summary} > {log} 2>&1"
+        " --observed {input.observed} --out {output.samples} > {log} 2>&1"
 
 
 rule calibration_check:
     input:
         emulator=f"{RESULTS}/emulator/emulator.json",
     output:
-        coverage=f"{RESULTS}/posterior/coverage.parquet",
-        trials=f"{RESULTS}/posterior/coverage_trials.parquet",
+        f"{RESULTS}/posterior/coverage.parquet",
     params:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
@@ -52,7 +51,7 @@ rule calibration_check:
         "../envs/shockcal.yaml"
     shell:
         "shockcal calibrate-check --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {SHOTS}"
-        " --out {output.coverage} > {log} 2>&1"
+        " --out {output} > {log} 2>&1"
 
 
 ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)

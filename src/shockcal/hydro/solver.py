@@ -8,7 +8,8 @@ target's front node nf+1 (no mass, no stress, its length is the gap). Both outer
 surfaces. Each step (leapfrog):
 1. nodes: u += dt (sigma_right - sigma_left) / m_node, sigma = -(P + q) + s;
 2. contact: if the gap would close, the two interface nodes take their common momentum velocity
-   (an inelastic node collision); under tension they separate, which opens the interface;
+   and the energy an impact dissipates goes to the interface cells; under tension the nodes
+   separate, which opens the interface;
 3. cells: length from the node velocities, strain rate, artificial viscosity (compression only),
    elastic trial deviator and Johnson-Cook radial return, energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included, growth limited to 10%.
@@ -48,6 +49,25 @@ def _total_energy(u, node_mass, E, cell_mass):
     for j in range(E.shape[0]):
         internal += cell_mass[j] * E[j]
     return kinetic + internal
+
+
+@njit(cache=True)
+def _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, approach_speed):
+    """Interface nodes in contact move together (momentum conserved). A collision between nodes
+    that approached at `approach_speed` before this step (the impact) dissipates
+    0.5 mu approach_speed^2; that energy goes into the two interface cells, as a shock would put it.
+    Nodes already moving together lose nothing: merging them is the combined node's momentum update."""
+    a, b = gap, gap + 1
+    common = (node_mass[a] * u[a] + node_mass[b] * u[b]) / (node_mass[a] + node_mass[b])
+    u[a] = common
+    u[b] = common
+    reduced_mass = node_mass[a] * node_mass[b] / (node_mass[a] + node_mass[b])
+    dissipated = 0.5 * reduced_mass * approach_speed * approach_speed
+    for j in (gap - 1, gap + 1):
+        dE = 0.5 * dissipated / cell_mass[j]
+        E[j] += dE
+        P[j] += g_rho0 * dE
+        sigma[j] -= g_rho0 * dE
 
 
 @njit(cache=True)
@@ -92,6 +112,7 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
 
     while k_out < n_out:
         # 1. momentum
+        approach_speed = u[gap] - u[gap + 1]
         for i in range(lo, hi + 1):
             left = sigma[i - 1] if i > 0 else 0.0
             right = sigma[i] if i <= N else 0.0
@@ -99,9 +120,7 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
         # 2. contact
         closing = length[gap] + dt * (u[gap + 1] - u[gap])
         if closing <= 0.0:
-            common = (node_mass[gap] * u[gap] + node_mass[gap + 1] * u[gap + 1]) / (node_mass[gap] + node_mass[gap + 1])
-            u[gap] = common
-            u[gap + 1] = common
+            _collide(u, node_mass, E, P, sigma, cell_mass, gap, gamma0 * rho0, max(approach_speed, 0.0))
         length[gap] = max(length[gap] + dt * (u[gap + 1] - u[gap]), 0.0)
         # 3. cells
         dt_next = dt_max

@@ -14,7 +14,7 @@ from matplotlib import patheffects
 
 from shockcal.plots.feature_space import usable
 from shockcal.plots.records import plot_feature_points
-from shockcal.plots.style import (COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, figure_legend, no_data, note, styled,
+from shockcal.plots.style import (COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, figure_legend, no_data, styled,
                                   subplots)
 
 TIME_COLUMNS = tuple(f"t_{key}" for key in FEATURES)
@@ -63,18 +63,17 @@ def fig_history(shot: str, training: pd.DataFrame | None, posterior: pd.DataFram
     if observed is not None:
         plot_feature_points(ax, observed, dt)
     total = 0 if training is None else len(usable(training))
-    lines = [f"{n_train} training runs" + (f" (of {total})" if n_train < total else ""), f"{n_post} posterior runs"]
-    if shift is None:
-        lines.append("measurement not shifted (no simulated features to align with)")
-    else:
-        lines.append(f"measurement shifted by {shift:+.3f} µs (estimated)")
+    counts = f"{n_train} training runs" + (f" (of {total})" if n_train < total else "") + f", {n_post} posterior runs"
     if observed is None and record is None:
-        lines.append("no measurement for this shot")
-    note(ax, "\n".join(lines), loc="lower right")
+        timing = "no measurement for this shot"
+    elif shift is None:
+        timing = "measurement not shifted (no simulated features to align with)"
+    else:
+        timing = f"measurement shifted by {shift:+.3f} µs (estimated)"
     _time_window(ax, training, posterior, observed, dt)
     ax.set_xlabel(TIME_LABEL)
     ax.set_ylabel(VELOCITY_LABEL)
-    ax.set_title(f"Shot {shot}: free-surface velocity")
+    ax.set_title(f"Shot {shot}: free-surface velocity\n{counts}; {timing}")
     figure_legend(fig, axes)
     return fig
 

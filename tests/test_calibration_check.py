@@ -1,0 +1,143 @@
+"""Calibration against a shot-aware stand-in emulator: likelihood formula, synthetic-truth coverage, CLI."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shockcal.calibration import Problem, calibrate, coverage_table, synthetic_truth
+from shockcal.errors import InputError
+
+FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
+SHOT_INPUTS = {"104S": ["A", "B", "C", "n", "m", "V1", "G1"],
+               "105S": ["A", "B", "C", "n", "m", "V2", "G1", "Delta2"],
+               "toy": ["A", "n"]}
+
+
+class ShotEmulator:
+    """Same interface as shockcal.emulator.Emulator: features linear in the box-scaled inputs."""
+
+    feature_names = FEATURES
+
+    def __init__(self, config, shots=("104S",), emulator_sd=0.5):
+        self.shots = list(shots)
+        self.bounds = {k: (v["min"], v["max"]) for k, v in config["inputs"].items()}
+        rng = np.random.default_rng(7)
+        self.base = {s: np.array([70.0, 200.0, 80.0, 190.0]) * (1 + 0.5 * i) for i, s in enumerate(self.shots)}
+        self.gain = {s: {k: rng.uniform(-8, 8, 4) for k in SHOT_INPUTS[s]} for s in self.shots}
+        self.sd = emulator_sd
+
+    def required_inputs(self, shots):
+        missing = [s for s in shots if s not in self.shots]
+        if missing:
+            raise InputError(f"the emulator has no shot {missing}")
+        needed = {k for s in shots for k in SHOT_INPUTS[s]}
+        return [k for k in self.bounds if k in needed]
+
+    def input_bounds(self, names):
+        return np.array([self.bounds[k][0] for k in names]), np.array([self.bounds[k][1] for k in names])
+
+    def predict(self, inputs, shots):
+        n = len(np.atleast_1d(inputs[self.required_inputs(shots)[0]]))
+        blocks = []
+        for s in shots:
+            m = np.tile(self.base[s], (n, 1))
+            for k, g in self.gain[s].items():
+                lo, hi = self.bounds[k]
+                m = m + ((np.asarray(inputs[k]) - lo) / (hi - lo) - 0.5)[:, None] * g
+            blocks.append(m)
+        f = 4 * len(shots)
+        return np.hstack(blocks), np.tile(self.sd**2 * np.eye(f), (n, 1, 1))
+
+
+def observed_at(emulator, shots, theta: dict) -> pd.DataFrame:
+    mean, _ = emulator.predict({k: np.array([v]) for k, v in theta.items()}, shots)
+    return pd.DataFrame(mean.reshape(len(shots), 4), columns=FEATURES).assign(shot=shots, source="test")
+
+
+def mid_box(emulator, shots) -> dict:
+    names = emulator.required_inputs(shots)
+    return dict(zip(names, np.mean(emulator.input_bounds(names), axis=0)))
+
+
+@pytest.fixture
+def small_config(paper_config):
+    paper_config["calibration"].update(walkers=32, burn_in_steps=200)
+    return paper_config
+
+
+def test_log_posterior_matches_the_gaussian_formula(small_config):
+    emu = ShotEmulator(small_config)
+    names = emu.required_inputs(["104S"])
+    lo, hi = emu.input_bounds(names)
+    theta = (lo + hi) / 2
+    problem = Problem.build(emu, ["104S"], observed_at(emu, ["104S"], dict(zip(names, theta * 1.01))), 0.01)
+    lam = 2.0
+    mean, cov = emu.predict(dict(zip(names, theta[:, None])), ["104S"])
+    total = cov[0] + np.diag((0.01 * problem.observed) ** 2) / lam
+    r = problem.observed - mean[0]
+    # Gaussian log density (no 2 pi) + log Gamma(5, 5) density of lambda + log Jacobian of log lambda
+    expected = -0.5 * r @ np.linalg.solve(total, r) - 0.5 * np.linalg.slogdet(total)[1] + 5 * np.log(lam) - 5 * lam
+    assert problem.log_posterior(np.append(theta, np.log(lam))[None])[0] == pytest.approx(expected, rel=1e-10)
+    assert problem.log_posterior(np.append(hi * 1.1, 0.0)[None])[0] == -np.inf
+
+
+def test_shot_without_emulator_is_rejected(small_config):
+    emu = ShotEmulator(small_config, shots=["104S"])
+    obs = pd.DataFrame([{"shot": "106S", **dict.fromkeys(FEATURES, 100.0)}])
+    with pytest.raises(InputError, match="no shot"):
+        calibrate(emu, ["106S"], obs, small_config, n_samples=100)
+
+
+def test_synthetic_truth_coverage_is_near_nominal(small_config):
+    # A two-input shot keeps 50 seeded trials fast; the 9-input version is a slow test below.
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    trials = synthetic_truth(emu, ["toy"], small_config, trials=50, seed=4, n_samples=800, walkers=16,
+                             burn_in_steps=50)
+    table = coverage_table(trials)
+    assert (table["trials"] == 50).all(), table
+    assert 0.84 <= trials["inside"].mean() <= 0.96, table
+
+
+@pytest.mark.slow
+def test_synthetic_truth_coverage_eight_inputs(small_config):
+    emu = ShotEmulator(small_config, shots=["105S"], emulator_sd=0.3)
+    trials = synthetic_truth(emu, ["105S"], small_config, trials=50, seed=4, n_samples=16000, walkers=32,
+                             burn_in_steps=500)
+    table = coverage_table(trials)
+    print(table.to_string())
+    assert 0.85 <= trials["inside"].mean() <= 0.95, table
+
+
+def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(small_config, tmp_path, monkeypatch,
+                                                                             capsys):
+    import yaml
+
+    from shockcal.cli import main
+    from shockcal.io import read_table_metadata
+
+    small_config["calibration"]["n_samples_single"] = 3200
+    config_path = tmp_path / "config.yaml"
+    config_path.write_text(yaml.safe_dump(small_config))
+    emu = ShotEmulator(small_config)
+    observed_at(emu, ["104S"], mid_box(emu, ["104S"])).to_csv(tmp_path / "obs.csv", index=False)
+    monkeypatch.setattr("shockcal.emulator.Emulator.load", classmethod(lambda cls, path: emu))
+    out = tmp_path / "post" / "104S.parquet"
+    args = ["calibrate", "--config", str(config_path), "--emulator", "E", "--shots", "104S",
+            "--observed", str(tmp_path / "obs.csv"), "--out", str(out)]
+    assert main(args) == 0
+    meta = read_table_metadata(out)
+    assert meta["units"]["V1"] == "cm/us" and meta["shots"] == ["104S"]
+    summary = pd.read_parquet(tmp_path / "post" / "104S_summary.parquet")
+    assert summary["parameter"].tolist() == [*emu.required_inputs(["104S"]), "lambda_y"]
+
+    monkeypatch.undo()
+    old = tmp_path / "old_emulator"
+    old.mkdir()
+    (old / "emulator.json").write_text(json.dumps({"format": "shockcal-emulator", "version": 0}))
+    (old / "emulator.npz").write_bytes(b"")
+    assert main([*args[:4], str(old), *args[5:]]) == 2
+    assert "version" in capsys.readouterr().err

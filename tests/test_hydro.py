@@ -1,0 +1,126 @@
+"""Verification of the hydrocode against closed-form solutions (thin plates keep these fast)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from shockcal.design import ShotParameters
+from shockcal.hydro import run_shot
+from shockcal.hydro.strength import hardening, radial_return, rate_factor, thermal_factor
+
+G = 0.27  # Mbar
+
+
+def _setup(config, flyer_mm, target_mm, end_time_us, cell_size_um=4.0):
+    config["hydro"].update(cell_size_um=cell_size_um, end_time_us=end_time_us)
+    return {"flyer_mm": flyer_mm, "target_mm": target_mm}
+
+
+def _hugoniot_shock_speed(config, up):
+    """Shock speed (cm/us) of the Mie-Grueneisen cubic EOS at particle velocity up (cm/us)."""
+    mat, eos = config["material"], config["material"]["eos"]
+    rho0 = mat["rho0_g_cc"]
+
+    def mismatch(mu):
+        p_eos = eos["c1_Mbar"] * mu + eos["c2_Mbar"] * mu**2 + eos["c3_Mbar"] * mu**3 + eos["gamma0"] * rho0 * 0.5 * up**2
+        return p_eos - rho0 * up**2 * (1.0 + mu) / mu
+
+    mu = brentq(mismatch, 1e-6, 0.5)
+    return up * (1.0 + mu) / mu
+
+
+def _arrival(t, v, level):
+    """First time the free-surface velocity crosses `level` (linear interpolation)."""
+    k = int(np.argmax(v >= level))
+    return t[k - 1] + (level - v[k - 1]) * (t[k] - t[k - 1]) / (v[k] - v[k - 1])
+
+
+@pytest.mark.parametrize("velocity", [0.0204, 0.03549, 0.04838])
+def test_no_strength_plateau_and_shock_speed(paper_config, velocity):
+    params = ShotParameters(0.0, 0.0, 0.0, 0.0, 0.0, velocity, G)
+    arrivals = []
+    for target_mm in (1.0, 2.0):
+        shot = _setup(paper_config, 3.0, target_mm, 0.9)
+        result = run_shot(params, shot, paper_config)
+        assert result.status == "ok", result.reason
+        t, v = result.t_us, result.v_m_s
+        arrivals.append(_arrival(t, v, 0.5 * velocity * 1e4))
+    plateau = v[(t > arrivals[1] + 0.2) & (t < arrivals[1] + 0.5)].mean()   # after the ringing, before release
+    assert plateau == pytest.approx(velocity * 1e4, rel=3e-3)
+    shock_speed = 0.1 / (arrivals[1] - arrivals[0])
+    assert shock_speed == pytest.approx(_hugoniot_shock_speed(paper_config, 0.5 * velocity), rel=1e-2)
+
+
+def test_hugoniot_speeds_match_issue(paper_config):
+    speeds = [_hugoniot_shock_speed(paper_config, 0.5 * v) * 1e4 for v in (0.0204, 0.03549, 0.04838)]
+    assert speeds == pytest.approx([5528, 5621, 5701], abs=3)
+
+
+def _elastic_reference(config, Y):
+    rho0, K = config["material"]["rho0_g_cc"], config["material"]["eos"]["c1_Mbar"]
+    modulus = K + 4.0 * G / 3.0
+    c_long = math.sqrt(modulus / rho0)
+    sigma_hel = modulus * Y / (2.0 * G)
+    return 2.0 * sigma_hel / (rho0 * c_long) * 1e4, c_long
+
+
+def _precursor(config, cell_size_um, Y=0.003, target_mm=2.0):
+    """Constant yield Y (B = C = 0, no thermal softening): (precursor amplitude m/s, arrival us)."""
+    config["material"]["T_melt_K"] = 1.0e12           # T* ~ 1e-10: no thermal softening
+    shot = _setup(config, 3.0, target_mm, 0.42, cell_size_um)
+    result = run_shot(ShotParameters(Y, 0.0, 0.0, 0.0, 1.0, 0.0204, G), shot, config)
+    assert result.status == "ok", result.reason
+    u_ref, c_long = _elastic_reference(config, Y)
+    t, v = result.t_us, result.v_m_s
+    t_elastic = target_mm * 0.1 / c_long
+    amplitude = np.median(v[(t > t_elastic + 0.02) & (t < t_elastic + 0.045)])
+    return amplitude, _arrival(t, v, 0.5 * amplitude), u_ref, t_elastic
+
+
+def test_constant_yield_precursor(paper_config):
+    amplitude, arrival, u_ref, t_elastic = _precursor(paper_config, 4.0)
+    assert amplitude == pytest.approx(u_ref, rel=2e-2)
+    assert arrival == pytest.approx(t_elastic, rel=5e-3)
+
+
+def test_mesh_convergence(paper_config):
+    """Precursor amplitude and plateau at 8, 4, 2 um agree with the analytic values and converge."""
+    amplitudes = [_precursor(paper_config, dx)[0] for dx in (8.0, 4.0, 2.0)]
+    u_ref = _elastic_reference(paper_config, 0.003)[0]
+    errors = [abs(a - u_ref) / u_ref for a in amplitudes]
+    assert max(errors) < 2e-2
+    assert errors[2] <= errors[0] + 2e-3
+
+
+def test_energy_conserved(paper_config):
+    shot = _setup(paper_config, 1.0, 1.5, 0.5)
+    result = run_shot(ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, G), shot, paper_config)
+    assert result.status == "ok", result.reason
+    assert result.energy_error < 1e-3
+
+
+def test_numerical_failure_is_reported(paper_config):
+    paper_config["hydro"]["cfl"] = 3.0                 # unstable on purpose
+    result = run_shot(ShotParameters(0.001, 0.0, 0.0, 0.0, 1.0, 0.0204, G), _setup(paper_config, 0.5, 0.5, 0.2),
+                      paper_config)
+    assert result.status == "failed"
+    assert "cell" in result.reason and "t =" in result.reason
+
+
+def test_strength_conventions():
+    assert hardening(0.001, 0.002, 0.0, 0.0) == pytest.approx(0.003)     # n = 0: eps^0 = 1
+    assert hardening(0.001, 0.002, 0.5, 0.0) == 0.001
+    assert rate_factor(0.03, 0.5e-6, 1e-6) == 1.0                         # ratio floored at 1
+    assert rate_factor(0.03, math.e * 1e-6, 1e-6) == pytest.approx(1.03)
+    assert thermal_factor(1.2, -0.1) == 1.0                               # T* <= 0: no softening
+    assert thermal_factor(0.0, 0.1) == 0.0                                # m = 0 limit, T* > 0
+    assert thermal_factor(0.0, 0.0) == 1.0
+    assert thermal_factor(2.0, 0.5) == pytest.approx(0.75)
+    s, d_eps = radial_return(-0.004, 0.003, G)                            # 1.5 * 0.004 = 0.006 > 0.003
+    assert 1.5 * abs(s) == pytest.approx(0.003) and s < 0
+    assert d_eps == pytest.approx(0.003 / (3 * G))
+    assert radial_return(0.001, 0.003, G) == (0.001, 0.0)
