@@ -1,0 +1,155 @@
+"""Features of a free-surface velocity trace by the Gaussian-mixture CDF method (SPEC section 4).
+
+1. Baseline and arrival: the baseline is the median of the trace before the rise and the noise
+   level its robust spread; the arrival is the first time the trace exceeds the baseline by
+   `ARRIVAL_FRACTION` of the total rise (or 5 noise sd, whichever is larger).
+2. Analysis window: from `PRE_ARRIVAL_US` before the arrival to `window_after_arrival_us` after it
+   (per shot in config; it must end before the release from the flyer's back reaches the free
+   surface). Measured records carry pre-trigger content and a baseline offset: both are outside
+   the window or removed by the standardization below.
+3. The windowed trace is standardized to run from 0 to 1, made monotone (running maximum) and read
+   as a CDF; 10,000 samples are drawn by the probability integral transform (uniform draws mapped
+   through the inverse CDF, linear interpolation of (y, t)).
+4. A k = 5 Gaussian mixture (scikit-learn, seeded) is fitted; components with mu + 2 sigma < c,
+   c = arrival + `cutoff_after_arrival_us`, form the early (elastic) mixture, the rest the late one.
+5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
+   points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
+   trace reaches 0.995. Each velocity is the trace's value at that time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize, stats
+
+FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
+COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
+ARRIVAL_FRACTION = 0.02
+NOISE_MULTIPLE = 5.0
+PRE_ARRIVAL_US = 0.05
+PLASTIC_LEVEL = 0.995
+
+
+class FeatureError(ValueError):
+    """The trace has no features (no rise, no elastic or plastic part): the run is marked failed."""
+
+
+@dataclass
+class Mixture:
+    """A 1-D Gaussian mixture (weights normalized), with its CDF and quantiles."""
+
+    weights: np.ndarray
+    means: np.ndarray
+    sds: np.ndarray
+
+    def cdf(self, x):
+        return np.sum(self.weights * stats.norm.cdf((np.atleast_1d(x)[:, None] - self.means) / self.sds), axis=1)
+
+    def quantile(self, p: float) -> float:
+        lo, hi = (self.means - 10 * self.sds).min(), (self.means + 10 * self.sds).max()
+        return optimize.brentq(lambda x: self.cdf(x)[0] - p, lo, hi, xtol=1e-9)
+
+    def subset(self, mask) -> "Mixture":
+        w = self.weights[mask]
+        return Mixture(w / w.sum(), self.means[mask], self.sds[mask])
+
+
+@dataclass
+class Extraction:
+    """Everything the extractor computed for one trace (the figures show the intermediate steps)."""
+
+    features: dict           # column -> value (times us, velocities m/s)
+    arrival_us: float
+    cutoff_us: float
+    window: tuple            # (start, end) us
+    t_window: np.ndarray
+    cdf_window: np.ndarray   # standardized, monotone trace on t_window
+    samples: np.ndarray      # PIT samples (us)
+    mixture: Mixture
+    early: np.ndarray        # boolean mask of early components
+
+
+def baseline_and_noise(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
+    """Median and robust sd of the trace before it first reaches half its maximum rise."""
+    half = np.argmax(v - v[0] >= 0.5 * (v.max() - v[0]))
+    quiet = v[: max(half // 2, 5)]
+    baseline = float(np.median(quiet))
+    noise = float(1.4826 * np.median(np.abs(quiet - baseline)))
+    return baseline, noise
+
+
+def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
+    """First time the trace rises above its baseline by a small share of the rise (or the noise)."""
+    baseline, noise = baseline_and_noise(t, v)
+    rise = v.max() - baseline
+    threshold = max(ARRIVAL_FRACTION * rise, NOISE_MULTIPLE * noise)
+    if rise <= 2 * threshold or rise <= 0:
+        raise FeatureError(f"no rise above the baseline (rise {rise:.3g} m/s, noise {noise:.3g} m/s)")
+    return float(t[np.argmax(v - baseline > threshold)])
+
+
+def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float, n_components: int = 5,
+            n_samples: int = 10000, seed: int = 0) -> Extraction:
+    """Run the extractor on one trace (t in us, v in m/s); raises FeatureError when it cannot."""
+    from sklearn.mixture import GaussianMixture
+
+    t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    arrival = detect_arrival(t, v)
+    start, end = arrival - PRE_ARRIVAL_US, arrival + window_after_arrival_us
+    if end > t[-1]:
+        raise FeatureError(f"trace ends at {t[-1]:.3f} us, before the analysis window ({end:.3f} us)")
+    inside = (t >= start) & (t <= end)
+    tw, vw = t[inside], v[inside]
+    y = np.maximum.accumulate((vw - vw.min()) / (vw.max() - vw.min()))
+    rising = np.diff(y, prepend=-1.0) > 0
+    rng = np.random.default_rng(seed)
+    samples = np.interp(rng.uniform(size=n_samples), y[rising], tw[rising])
+    gm = GaussianMixture(n_components, random_state=seed).fit(samples[:, None])
+    mixture = Mixture(gm.weights_, gm.means_.ravel(), np.sqrt(gm.covariances_.ravel()))
+    cutoff = arrival + cutoff_after_arrival_us
+    early = mixture.means + 2 * mixture.sds < cutoff
+    if not early.any() or early.all():
+        raise FeatureError(f"the mixture has no {'early' if not early.any() else 'late'} component "
+                           f"(cut-off {cutoff:.3f} us; component means {np.round(mixture.means, 3).tolist()} us)")
+    early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
+    times = {"jumpoff": early_mix.quantile(0.01), "elastic": early_mix.quantile(0.99),
+             "slope1": late_mix.quantile(0.1), "slope2": late_mix.quantile(0.9),
+             "plastic": float(tw[np.argmax(y >= PLASTIC_LEVEL)])}
+    features = {}
+    for name in FEATURES:
+        features[f"t_{name}"] = float(times[name])
+        features[f"v_{name}"] = float(np.interp(times[name], t, v))
+    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
+
+
+def extract_features(t, v, analysis: dict, settings: dict, seed: int = 0) -> dict:
+    """The ten feature values of a trace with the config's per-shot analysis and features settings."""
+    return extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
+                   settings["n_components"], settings["n_samples"], seed).features
+
+
+def features_table(traces, config: dict, shot: str, seed: int) -> "pd.DataFrame":
+    """One row per simulated run: run, status, reason and the ten features.
+
+    Failed simulations keep their status and reason; a trace the extractor cannot read becomes
+    status "failed" with the extractor's reason. Each run's mixture seed is `seed + run`, so a run's
+    features do not depend on which chunk or batch it was extracted in.
+    """
+    import pandas as pd
+
+    analysis, settings = config["shots"][shot]["analysis"], config["features"]
+    rows = []
+    for record in traces.to_dict("records"):
+        row = {"run": int(record["run"]), "status": record["status"], "reason": record["reason"]}
+        if record["status"] == "ok":
+            try:
+                row.update(extract_features(record["t_us"], record["v_m_s"], analysis, settings, seed + row["run"]))
+            except FeatureError as exc:
+                row.update(status="failed", reason=f"feature extraction: {exc}")
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    for column in COLUMNS:
+        table[column] = table[column].astype(float) if column in table else np.nan
+    return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
