@@ -39,7 +39,7 @@ FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "
 DT_FLOOR_US = 1.0e-12
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _total_energy(u, node_mass, E, cell_mass):
     """Kinetic + internal energy per unit area (Mbar cm)."""
     kinetic = 0.0
@@ -51,7 +51,7 @@ def _total_energy(u, node_mass, E, cell_mass):
     return kinetic + internal
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, approach_speed):
     """Interface nodes in contact move together (momentum conserved). A collision between nodes
     that approached at `approach_speed` before this step (the impact) dissipates
@@ -70,7 +70,7 @@ def _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, approach_speed):
         sigma[j] -= g_rho0 * dE
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, T_ref, T_melt, cv,
               rate_ref, q1, q2, cfl, dt_initial, dt_max, t_out):
     """Run to t_out[-1]; returns (v_free_surface, energy_at_outputs, status, fail_cell, fail_time,
@@ -89,6 +89,10 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
     eps_p = np.zeros(N + 1)
     plastic_rate = np.zeros(N + 1)
     hard = np.full(N + 1, hardening(A, B, n, 0.0))
+    # a lower bound of each cell's flow stress, valid while its temperature stays <= floor_T:
+    # a trial stress inside it is elastic without evaluating pow/log (see _flow_floor)
+    flow_floor = np.zeros(N + 1)
+    floor_T = np.full(N + 1, np.inf)
     u = np.zeros(N + 2)
     u[: nf + 1] = velocity
     node_mass = np.empty(N + 2)
@@ -109,6 +113,8 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
     steps = 0
     max_rate, max_T, max_eps = 0.0, T_ref, 0.0
     four_thirds_G = 4.0 * G / 3.0
+    g_rho0 = gamma0 * rho0
+    inv_T_range = 1.0 / (T_melt - T_ref)
 
     while k_out < n_out:
         # 1. momentum
@@ -123,7 +129,7 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
             _collide(u, node_mass, E, P, sigma, cell_mass, gap, gamma0 * rho0, max(approach_speed, 0.0))
         length[gap] = max(length[gap] + dt * (u[gap + 1] - u[gap]), 0.0)
         # 3. cells
-        dt_next = dt_max
+        max_signal_rate = cfl / dt_max         # (signal speed / cell length), the CFL limit is cfl / max
         for j in range(max(lo - 1, 0), min(hi, N) + 1):
             if j == gap:
                 continue
@@ -132,28 +138,31 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
             new_length = old_length + dt * du
             if not new_length > 0.0:
                 return v_out, energy_out, STATUS_NEGATIVE_VOLUME, j, t, steps, max_rate, max_T, max_eps
-            strain_rate = du / (0.5 * (old_length + new_length))
-            rho = cell_mass[j] / new_length
-            mu = rho / rho0 - 1.0
-            c_bulk_sq = bulk_sound_speed_sq(mu, P[j], rho, rho0, c1, c2, c3, gamma0)
-            c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G / rho)
-            q_new = rho * (q2 * du * du - q1 * c_long * du) if du < 0.0 else 0.0
+            strain_rate = 2.0 * du / (old_length + new_length)
+            volume = new_length / cell_mass[j]       # specific volume 1/rho
+            mu = 1.0 / (rho0 * volume) - 1.0
+            c_bulk_sq = bulk_sound_speed_sq(mu, P[j], volume, rho0, c1, c2, c3, gamma0)
+            c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
+            q_new = (q2 * du * du - q1 * c_long * du) / volume if du < 0.0 else 0.0
             # strength: elastic trial, Johnson-Cook flow stress, radial return
             s_trial = s[j] + four_thirds_G * strain_rate * dt
             T_cell = T_ref + E[j] / cv
-            flow = 0.0
-            if 1.5 * abs(s_trial) > 0.0:
-                flow = hard[j] * rate_factor(C, plastic_rate[j], rate_ref) * thermal_factor(m, (T_cell - T_ref) / (T_melt - T_ref))
-            s_new, d_eps = radial_return(s_trial, flow, G)
-            if d_eps > 0.0:
-                eps_p[j] += d_eps
-                hard[j] = hardening(A, B, n, eps_p[j])
+            if 1.5 * abs(s_trial) <= flow_floor[j] and T_cell <= floor_T[j]:
+                s_new, d_eps = s_trial, 0.0
+            else:
+                thermal = thermal_factor(m, (T_cell - T_ref) * inv_T_range)
+                flow = hard[j] * rate_factor(C, plastic_rate[j], rate_ref) * thermal
+                s_new, d_eps = radial_return(s_trial, flow, G)
+                if d_eps > 0.0:
+                    eps_p[j] += d_eps
+                    hard[j] = hardening(A, B, n, eps_p[j])
+                flow_floor[j] = hard[j] * thermal     # the rate factor is >= 1, thermal(T) falls with T
+                floor_T[j] = T_cell
             plastic_rate[j] = d_eps / dt
             # energy: dE = -(P + q) dV + s_mean * strain_rate * dt / rho, P implicit (trapezoid)
-            dV = (new_length - old_length) / cell_mass[j]
-            work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt / rho
+            dV = dt * du / cell_mass[j]
+            work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
             p_cold = cold_pressure(mu, c1, c2, c3)
-            g_rho0 = gamma0 * rho0
             E_new = (E[j] - (0.5 * (P[j] + p_cold) + q_new) * dV + work_dev) / (1.0 + 0.5 * g_rho0 * dV)
             P[j] = p_cold + g_rho0 * E_new
             if not (E_new == E_new and P[j] == P[j]):
@@ -169,7 +178,9 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
                 max_eps = max(max_eps, eps_p[j])
             # 4. time step: dt = cfl L / (a + sqrt(a^2 + c^2)), a the viscous signal speed
             a_visc = (q1 * c_long + 2.0 * q2 * abs(du)) if du < 0.0 else 0.0
-            dt_next = min(dt_next, cfl * new_length / (a_visc + math.sqrt(a_visc * a_visc + c_long * c_long)))
+            signal = a_visc + math.sqrt(a_visc * a_visc + c_long * c_long) if du < 0.0 else c_long
+            max_signal_rate = max(max_signal_rate, signal / new_length)
+        dt_next = cfl / max_signal_rate
         # grow the active window where a cell beyond it has started to move
         if lo > 0 and sigma[lo - 1] != 0.0:
             lo -= 1

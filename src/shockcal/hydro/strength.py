@@ -19,7 +19,7 @@ import math
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hardening(A, B, n, eps_p):
     """A + B eps_p^n (Mbar), with eps_p^0 = 1."""
     if n == 0.0:
@@ -29,14 +29,14 @@ def hardening(A, B, n, eps_p):
     return A + B * eps_p**n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rate_factor(C, strain_rate, strain_rate_ref):
     """1 + C ln(max(rate/rate_ref, 1))."""
     ratio = strain_rate / strain_rate_ref
     return 1.0 + C * math.log(ratio) if ratio > 1.0 else 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def thermal_factor(m, homologous_T):
     """1 - T*^m with the conventions above."""
     if homologous_T <= 0.0:
@@ -46,7 +46,7 @@ def thermal_factor(m, homologous_T):
     return 1.0 - homologous_T**m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def radial_return(s_trial, flow_stress, G):
     """Return (s, d eps_p): the trial deviator scaled back onto the yield surface if outside it."""
     equivalent = 1.5 * abs(s_trial)

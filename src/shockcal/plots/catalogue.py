@@ -41,14 +41,19 @@ class FigureInputs:
         """{name: table of `kind:name`} for each name."""
         return {name: self.table(f"{kind}:{name}") for name in names}
 
-    def record(self, shot: str) -> pd.DataFrame | None:
-        """The measured record of `shot` (t_us, v_m_s), read with the project's record reader."""
+    def record(self, shot: str, config: dict) -> pd.DataFrame | None:
+        """The measured record of `shot` (t_us, v_m_s), read with the project's record reader and the
+        columns named in observed.records.<shot> (if any)."""
         paths = self.files.get(f"record:{shot}")
         if not paths:
             return None
+        import pandas as pd
+
         from shockcal.records import read_record
 
-        return read_record(paths[0])
+        spec = config["observed"]["records"].get(shot, {})
+        t, v = read_record(paths[0], spec.get("time_column"), spec.get("velocity_column"))
+        return pd.DataFrame({"t_us": t, "v_m_s": v})
 
 
 @dataclass(frozen=True)
@@ -72,14 +77,14 @@ def _records(inputs, config):
     from shockcal.plots.records import fig02_records
 
     shots = _shots(config)
-    return fig02_records({s: inputs.record(s) for s in shots}, inputs.table("observed"), shots)
+    return fig02_records({s: inputs.record(s, config) for s in shots}, inputs.table("observed"), shots)
 
 
 def _trace_figure(which, inputs, config):
     from shockcal.plots import mixture
 
     shot = _shots(config)[0]
-    trace, label = mixture.pick_trace(inputs.record(shot), inputs.table(f"simulations:{shot}"), shot)
+    trace, label = mixture.pick_trace(inputs.record(shot, config), inputs.table(f"simulations:{shot}"), shot)
     return getattr(mixture, which)(trace, label, config, shot)
 
 
@@ -128,7 +133,7 @@ def _history(shot, inputs, config):
     if aligned_to is None:
         aligned_to = inputs.table(f"features:{shot}")
     return fig_history(shot, inputs.table(f"simulations:{shot}"), inputs.table(f"predicted_simulations:{shot}"),
-                       measured, inputs.record(shot), estimate_time_shift(measured, aligned_to),
+                       measured, inputs.record(shot, config), estimate_time_shift(measured, aligned_to),
                        seed=config["study"]["seed"])
 
 

@@ -1,8 +1,8 @@
 """Figures of the feature extractor on one trace: 4 (the features), 5 (early/late mixture split),
 15 (the probability-integral-transform construction).
 
-The numbers come from the project's extractor (`shockcal.features`), through `extract_view`,
-which returns everything the three figures draw (`MixtureView`). The trace is the first shot's
+The numbers come from the project's extractor (`shockcal.features.extract`, whose `Extraction`
+keeps the window, the standardized trace, the PIT samples, the mixture and its early/late split). The trace is the first shot's
 measured record when one is configured, else its first usable simulated training run.
 """
 
@@ -19,24 +19,6 @@ from shockcal.plots.records import plot_feature_points
 from shockcal.plots.style import COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, no_data, styled, subplots
 
 
-@dataclass(frozen=True)
-class MixtureView:
-    """One extraction, laid out for plotting (times in us, velocities in m/s)."""
-
-    t: np.ndarray            # the whole trace
-    v: np.ndarray
-    window: tuple[float, float]
-    t_std: np.ndarray        # standardized, monotone trace over the window: y(t_std) from 0 to 1
-    y_std: np.ndarray
-    samples: np.ndarray      # PIT samples (times)
-    weights: np.ndarray      # mixture components
-    means: np.ndarray
-    sds: np.ndarray
-    early: np.ndarray        # bool per component
-    cutoff: float
-    features: pd.Series      # t_* and v_* of the five features
-
-
 def pick_trace(record: pd.DataFrame | None, simulations: pd.DataFrame | None, shot: str):
     """(trace table with t_us, v_m_s; description) or (None, reason)."""
     if record is not None and not record.empty:
@@ -49,15 +31,28 @@ def pick_trace(record: pd.DataFrame | None, simulations: pd.DataFrame | None, sh
     return trace, f"simulated training run {int(first['run'])}, shot {shot}"
 
 
-def extract_view(trace: pd.DataFrame, config: dict, shot: str) -> MixtureView:
-    """Run the project's extractor on `trace` and collect what the figures draw."""
-    from shockcal import features
+@dataclass(frozen=True)
+class TraceExtraction:
+    """A whole trace (times in us, velocities in m/s) and the extractor's account of it."""
+
+    t: np.ndarray
+    v: np.ndarray
+    ex: object  # shockcal.features.Extraction
+
+    @property
+    def features(self) -> pd.Series:
+        return pd.Series(self.ex.features)
+
+
+def extract_view(trace: pd.DataFrame, config: dict, shot: str) -> TraceExtraction:
+    """Run the project's extractor on `trace` with the shot's analysis settings."""
+    from shockcal.features import extract
 
     t, v = trace["t_us"].to_numpy(float), trace["v_m_s"].to_numpy(float)
-    d = features.extract_diagnostics(t, v, config, shot)
-    return MixtureView(t=t, v=v, window=d.window, t_std=d.t_window, y_std=d.y_standardized, samples=d.samples,
-                       weights=d.weights, means=d.means, sds=d.sds, early=d.early, cutoff=d.cutoff,
-                       features=pd.Series(d.features))
+    analysis, settings = config["shots"][shot]["analysis"], config["features"]
+    ex = extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
+                 settings["n_components"], settings["n_samples"], seed=config["study"]["seed"])
+    return TraceExtraction(t, v, ex)
 
 
 def _view_or_note(trace, label, config, shot):
@@ -70,10 +65,11 @@ def _view_or_note(trace, label, config, shot):
         return None, f"extractor failed on {label}: {exc}"
 
 
-def _mixture_pdf(view: MixtureView, grid, which):
+def _mixture_pdf(view: TraceExtraction, grid, which):
     from scipy.stats import norm
 
-    return sum(w * norm.pdf(grid, m, s) for w, m, s, e in zip(view.weights, view.means, view.sds, view.early)
+    mix = view.ex.mixture
+    return sum(w * norm.pdf(grid, m, s) for w, m, s, e in zip(mix.weights, mix.means, mix.sds, view.ex.early)
                if which is None or e == which)
 
 
@@ -86,7 +82,7 @@ def fig04_trace_features(trace, label: str, config: dict, shot: str):
     if view is None:
         no_data(ax, problem)
         return fig
-    ax.axvspan(*view.window, color=COLORS["prior"], alpha=0.6, lw=0, label="analysis window")
+    ax.axvspan(*view.ex.window, color=COLORS["prior"], alpha=0.6, lw=0, label="analysis window")
     ax.plot(view.t, view.v, color="black", lw=1.2, label="trace")
     plot_feature_points(ax, view.features, label="features")
     for key, name in FEATURES.items():
@@ -94,7 +90,7 @@ def fig04_trace_features(trace, label: str, config: dict, shot: str):
         ax.annotate(name, (view.features[f"t_{key}"], view.features[f"v_{key}"]), xytext=offset,
                     textcoords="offset points", fontsize=8, color=COLORS["measurement"],
                     ha="center" if key == "plastic" else "left")
-    lo, hi = view.window
+    lo, hi = view.ex.window
     ax.set_xlim(lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo))
     ax.set_xlabel(TIME_LABEL)
     ax.set_ylabel(VELOCITY_LABEL)
@@ -112,16 +108,16 @@ def fig05_mixture_split(trace, label: str, config: dict, shot: str):
     if view is None:
         no_data(ax, problem)
         return fig
-    grid = np.linspace(*view.window, 600)
-    ax.hist(view.samples, bins=80, range=view.window, density=True, color=COLORS["training"], alpha=0.45, lw=0,
-            label=f"{len(view.samples):,} PIT samples")
+    grid = np.linspace(*view.ex.window, 600)
+    ax.hist(view.ex.samples, bins=80, range=view.ex.window, density=True, color=COLORS["training"], alpha=0.45, lw=0,
+            label=f"{len(view.ex.samples):,} PIT samples")
     ax.plot(grid, _mixture_pdf(view, grid, None), color="black", lw=1.2, label="mixture (5 components)")
     ax.fill_between(grid, _mixture_pdf(view, grid, True), color=COLORS["early"], alpha=0.45, lw=0,
-                    label=f"early components ({int(view.early.sum())})")
+                    label=f"early components ({int(view.ex.early.sum())})")
     ax.fill_between(grid, _mixture_pdf(view, grid, False), color=COLORS["late"], alpha=0.35, lw=0,
-                    label=f"late components ({int((~view.early).sum())})")
-    ax.axvline(view.cutoff, color="black", ls="--", lw=1, label=f"cut-off c = {view.cutoff:.3f} µs")
-    ax.set_xlim(view.window)
+                    label=f"late components ({int((~view.ex.early).sum())})")
+    ax.axvline(view.ex.cutoff_us, color="black", ls="--", lw=1, label=f"cut-off c = {view.ex.cutoff_us:.3f} µs")
+    ax.set_xlim(view.ex.window)
     ax.set_xlabel(TIME_LABEL)
     ax.set_ylabel("density (1/µs)")
     ax.legend(loc="upper right")
@@ -139,10 +135,10 @@ def fig15_pit_construction(trace, label: str, config: dict, shot: str, n_arrows:
         for ax in (top, bottom):
             no_data(ax, problem)
         return fig
-    top.plot(view.t_std, view.y_std, color="black", lw=1.4, label="standardized, monotone trace y(t)")
+    top.plot(view.ex.t_window, view.ex.cdf_window, color="black", lw=1.4, label="standardized, monotone trace y(t)")
     for u in (np.arange(n_arrows) + 0.5) / n_arrows:
-        t_u = float(np.interp(u, view.y_std, view.t_std))
-        top.annotate("", xy=(t_u, u), xytext=(view.window[0], u),
+        t_u = float(np.interp(u, view.ex.cdf_window, view.ex.t_window))
+        top.annotate("", xy=(t_u, u), xytext=(view.ex.window[0], u),
                      arrowprops={"arrowstyle": "->", "color": COLORS["model"], "lw": 0.9})
         top.annotate("", xy=(t_u, 0), xytext=(t_u, u),
                      arrowprops={"arrowstyle": "->", "color": COLORS["model"], "lw": 0.9, "ls": ":"})
@@ -151,9 +147,9 @@ def fig15_pit_construction(trace, label: str, config: dict, shot: str, n_arrows:
     top.set_ylim(0, 1.02)
     top.legend(loc="lower right")
     top.set_title(label)
-    bottom.hist(view.samples, bins=80, range=view.window, density=True, color=COLORS["model"], alpha=0.5, lw=0,
-                label=f"{len(view.samples):,} samples t = y⁻¹(u)")
-    bottom.set_xlim(view.window)
+    bottom.hist(view.ex.samples, bins=80, range=view.ex.window, density=True, color=COLORS["model"], alpha=0.5, lw=0,
+                label=f"{len(view.ex.samples):,} samples t = y⁻¹(u)")
+    bottom.set_xlim(view.ex.window)
     bottom.set_xlabel(TIME_LABEL)
     bottom.set_ylabel("density (1/µs)")
     bottom.legend(loc="upper right")
