@@ -1,5 +1,8 @@
 # Shared helpers of the rule files: the effective config, chunking, config slices.
-# (workflow engineer: read /work/main/.notes/workflow.md before editing these rules)
+import os
+import sys
+from pathlib import Path
+
 import yaml
 
 from shockcal.design import chunk_fingerprints, planned_design
@@ -7,13 +10,15 @@ from shockcal.design import chunk_fingerprints, planned_design
 
 def _write_if_changed(path, text):
     """Write `path` only when its content changes (every job re-reads the Snakefile)."""
-    from pathlib import Path
-
     path = Path(path)
     if not path.exists() or path.read_text() != text:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
 
+
+# Rules call the `shockcal` console script: find it next to the Python running snakemake even when
+# that environment is not activated (`.venv/bin/snakemake ...`); a conda env, when used, comes first.
+os.environ["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
 
 # The merged config (configfile + --configfile + --config) that every shockcal call reads. It is
 # not a rule input: reruns follow each rule's params slice, never this file's mtime.

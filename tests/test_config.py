@@ -1,0 +1,75 @@
+"""Bad configs are rejected up front, with the key path and the reason in the message."""
+
+from __future__ import annotations
+
+import pytest
+
+from shockcal.config import load_config, shot_config, validate_config
+from shockcal.errors import ConfigError
+
+
+def _set(config: dict, path: str, value) -> None:
+    *parents, last = path.split(".")
+    node = config
+    for key in parents:
+        node = node[key]
+    node[last] = value
+
+
+def test_paper_config_is_valid(paper_config):
+    validate_config(paper_config)
+    assert list(paper_config["shots"]) == ["104S", "105S", "106S"]
+
+
+@pytest.mark.parametrize(
+    "path, value, message",
+    [
+        ("hydro.cell_size_um", "four", r"hydro\.cell_size_um: 'four' is not of type 'number'"),
+        ("shots.104S.target_mm", -2.0, r"shots\.104S\.target_mm: -2\.0 is less than or equal to the minimum"),
+        ("simulate.chunk_size", 0, r"simulate\.chunk_size: 0 is less than the minimum of 1"),
+        ("inputs.A.min", 0.02, r"inputs\.A: min \(0\.02\) must be below max"),
+        ("inputs.B.min", -0.001, r"inputs\.B\.min: Johnson-Cook parameters cannot be negative"),
+        ("shots.105S.velocity_input", "V9", r"shots\.105S\.velocity_input: 'V9' is not one of the inputs"),
+        ("observed.records", {"104S": {"path": "no/such/record.txt"}},
+         r"observed\.records\.104S\.path: no/such/record\.txt does not exist"),
+        ("design.file", "no/such/design.csv", r"design\.file: no/such/design\.csv does not exist"),
+    ],
+)
+def test_bad_values_name_key_and_reason(paper_config, path, value, message):
+    _set(paper_config, path, value)
+    with pytest.raises(ConfigError, match=message):
+        validate_config(paper_config, source="config.yaml")
+
+
+def test_observed_features_of_unknown_shot(paper_config):
+    paper_config["observed"]["features"]["107S"] = dict(paper_config["observed"]["features"]["104S"])
+    with pytest.raises(ConfigError, match=r"observed\.features\.107S: unknown shot"):
+        validate_config(paper_config)
+
+
+def test_missing_key_is_named(paper_config):
+    del paper_config["shots"]["106S"]["flyer_mm"]
+    with pytest.raises(ConfigError, match=r"shots\.106S: 'flyer_mm' is a required property"):
+        validate_config(paper_config)
+
+
+def test_unknown_shot_is_named(paper_config):
+    with pytest.raises(ConfigError, match=r"unknown shot '107S'"):
+        shot_config(paper_config, "107S")
+
+
+def test_unquoted_shot_names_become_strings(tmp_path, paper_config):
+    shots = paper_config["shots"]
+    paper_config["shots"] = {104: shots["104S"]}
+    paper_config["observed"]["features"] = {}
+    validate_config(paper_config)
+    assert list(paper_config["shots"]) == ["104"]
+
+
+def test_unreadable_files(tmp_path):
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_config(tmp_path / "missing.yaml")
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("shots: [unclosed\n")
+    with pytest.raises(ConfigError, match=f"{broken} is not valid YAML"):
+        load_config(broken)
