@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.calibration import Problem, calibrate, coverage_table, synthetic_truth
+from shockcal.calibration import HydroTruths, Problem, calibrate, coverage_table, synthetic_truth
 from shockcal.errors import InputError
 
 FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -100,6 +100,39 @@ def test_synthetic_truth_coverage_is_near_nominal(small_config):
     table = coverage_table(trials)
     assert (table["trials"] == 50).all(), table
     assert 0.84 <= trials["inside"].mean() <= 0.96, table
+
+
+def _toy_hydro_truths(emu, config, n_runs=60):
+    """Stand-in hydrocode runs: uniform theta, features = the emulator's mean plus its own error
+    (sd 0.3 m/s, which the emulator's covariance reports); run 0 failed, run 1 non-positive."""
+    rng = np.random.default_rng(11)
+    lower, upper = emu.input_bounds(["A", "n"])
+    theta = rng.uniform(lower, upper, size=(n_runs, 2))
+    design = pd.DataFrame({"run": np.arange(n_runs), "A": theta[:, 0], "n": theta[:, 1], "m": 1.0})
+    mean, _ = emu.predict({"A": theta[:, 0], "n": theta[:, 1]}, ["toy"])
+    features = pd.DataFrame(mean + emu.sd * rng.normal(size=mean.shape), columns=FEATURES)
+    features.insert(0, "run", np.arange(n_runs))
+    features.insert(1, "status", ["failed"] + ["ok"] * (n_runs - 1))
+    features.loc[1, "v_slope1"] = -3.0
+    return HydroTruths(design, {"toy": features}), theta
+
+
+def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    truths, theta = _toy_hydro_truths(emu, small_config)
+    draws = list(truths.draws(["A", "n"], ["toy"]))
+    assert len(draws) == 58
+    np.testing.assert_array_equal(draws[0][0], theta[2])
+    assert draws[0][1].shape == (4,)
+
+
+def test_hydro_truth_coverage_is_near_nominal(small_config):
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    truths, _ = _toy_hydro_truths(emu, small_config)
+    trials = synthetic_truth(emu, ["toy"], small_config, trials=50, seed=5, truths=truths, n_samples=800,
+                             walkers=16, burn_in_steps=50)
+    assert trials["trial"].nunique() == 50
+    assert 0.84 <= trials["inside"].mean() <= 0.96, coverage_table(trials)
 
 
 @pytest.mark.slow

@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from shockcal.diagnostics import RHAT_LIMIT, ess_bulk, ess_tail, split_rhat
+from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
 from shockcal.sampler import run_ensemble
 
@@ -148,21 +149,23 @@ def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str
     return samples, summary, info
 
 
-def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, **overrides) -> pd.DataFrame:
-    """Calibrate on synthetic truth drawn from the model itself; one row per trial and parameter.
+def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truths=None, **overrides) -> pd.DataFrame:
+    """Calibrate on synthetic truth with a known theta; one row per trial and parameter.
 
-    Each trial draws theta uniformly on the box and lambda_y from its prior, features from the
-    emulator's predictive distribution at theta plus observation noise of sd = sd_fraction /
-    sqrt(lambda_y) of each feature, and calibrates (`overrides` as in `calibrate`). Columns:
-    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), r_hat.
+    Each trial draws lambda_y from its prior and takes theta and noise-free features either from the
+    emulator (theta uniform on the box, features from its predictive distribution at theta) or, when
+    `truths` is given, from hydrocode runs (`HydroTruths`: theta of each run and its extracted
+    features). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is added and
+    the features are calibrated (`overrides` as in `calibrate`). Columns: trial, parameter, truth,
+    q05, q95, inside (the 90% interval holds the truth), r_hat.
     """
     rng = np.random.default_rng(seed)
     names = emulator.required_inputs(shots)
-    lower, upper = emulator.input_bounds(names)
     sd_fraction = config["observed"]["sd_fraction"]
+    draw_truth = _emulator_truth(emulator, shots, names, rng) if truths is None else truths.draws(names, shots)
     rows = []
     for trial in range(trials):
-        theta, lam, y = _synthetic_features(emulator, shots, names, lower, upper, sd_fraction, rng)
+        theta, lam, y = _noisy_truth(draw_truth, sd_fraction, rng)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
         _, summary, _ = calibrate(emulator, shots, observed, config, source=f"synthetic trial {trial}",
                                   seed=int(rng.integers(2**31)), **overrides)
@@ -175,18 +178,47 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, **ove
     return pd.DataFrame(rows)
 
 
-def _synthetic_features(emulator, shots, names, lower, upper, sd_fraction, rng):
-    """(theta, lambda_y, y) drawn from prior and model; draws with a non-positive feature (no
-    measurement would report one) are redrawn."""
-    while True:
-        theta = rng.uniform(lower, upper)
+def _noisy_truth(draw_truth, sd_fraction, rng):
+    """(theta, lambda_y, pseudo-measured features): the next truth with lambda_y from its prior and
+    noise of sd = sd_fraction / sqrt(lambda_y) of each feature. A draw with a non-positive feature
+    (no measurement reports one) is replaced by the next truth."""
+    for theta, eta in draw_truth:
         lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1])
-        mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
-        eta = rng.multivariate_normal(mean[0], cov[0])
         y = eta + sd_fraction * np.abs(eta) / np.sqrt(lam) * rng.normal(size=eta.shape)
         if np.all(y > 0):
             return theta, lam, y
-        log.info("synthetic draw with a non-positive feature at %s: redrawn", dict(zip(names, theta.round(5))))
+        log.info("synthetic truth with a non-positive feature: replaced by the next draw")
+    raise InputError("synthetic truth: no draws left for the requested number of trials")
+
+
+def _emulator_truth(emulator, shots, names, rng):
+    """Endless (theta, features): theta uniform on the box, features from the emulator's predictive
+    distribution at theta."""
+    lower, upper = emulator.input_bounds(names)
+    while True:
+        theta = rng.uniform(lower, upper)
+        mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
+        yield theta, rng.multivariate_normal(mean[0], cov[0])
+
+
+@dataclass
+class HydroTruths:
+    """Hydrocode runs as synthetic truth: their design (theta per run) and, per shot, their features."""
+
+    design: pd.DataFrame
+    features: dict            # shot -> features table (run, status, feature columns)
+
+    def draws(self, names, shots):
+        """(theta, features) of each run, in run order, with every shot's features ok and positive."""
+        table = self.design.set_index("run")
+        for shot in shots:
+            ok = self.features[shot].query("status == 'ok'").set_index("run")
+            table = table.join(ok[CALIBRATION_FEATURES].add_prefix(f"{shot}:"), how="inner")
+        columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES]
+        usable = table[(table[columns] > 0).all(axis=1)]
+        log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable), len(self.design))
+        for _, row in usable.iterrows():
+            yield row[names].to_numpy(float), row[columns].to_numpy(float)
 
 
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
@@ -195,10 +227,12 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
                                                        max_r_hat=("r_hat", "max")).reset_index()
 
 
-def coverage_check(emulator, shots, config: dict, trials: int | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The configured synthetic-truth check (calibration.check): per-trial table and coverage per parameter."""
+def coverage_check(emulator, shots, config: dict, trials: int | None = None,
+                   truths: HydroTruths | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The configured synthetic-truth check (calibration.check), on emulator or hydrocode truth:
+    per-trial table and coverage per parameter."""
     settings, check = config["calibration"], config["calibration"]["check"]
     table = synthetic_truth(emulator, shots, config, trials or check["trials"],
-                            seed=config["study"]["seed"] + settings["seed_offset"] + 1,
+                            seed=config["study"]["seed"] + settings["seed_offset"] + 1, truths=truths,
                             n_samples=check["n_samples"], burn_in_steps=check["burn_in_steps"])
     return table, coverage_table(table)

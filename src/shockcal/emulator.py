@@ -1,4 +1,3 @@
-# (emulator engineer: read /work/main/.notes/emulator.md before editing this module)
 """Principal-component Gaussian-process emulator of the calibration features (SPEC section 5).
 
 Features y (m/s) of each training run are standardized per feature (mean vector, sd vector),

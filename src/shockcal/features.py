@@ -96,6 +96,9 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     from sklearn.mixture import GaussianMixture
 
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    bad = ~(np.isfinite(t) & np.isfinite(v))
+    if bad.any():
+        raise FeatureError(f"{int(bad.sum())} non-finite values in the trace (first at index {int(np.argmax(bad))})")
     arrival = detect_arrival(t, v)
     start, end = arrival - PRE_ARRIVAL_US, arrival + window_after_arrival_us
     if end > t[-1]:

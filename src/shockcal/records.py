@@ -18,7 +18,7 @@ import pandas as pd
 from shockcal.errors import InputError
 
 MIN_POINTS = 50
-_TIME_NAMES = re.compile(r"^(t|time)\b", re.IGNORECASE)
+_TIME_NAMES = re.compile(r"^(t|time|t_us)\b", re.IGNORECASE)
 _VELOCITY_NAMES = re.compile(r"^(up|u|v|vel|velocity|ufs|u_fs|v_m_s)\b", re.IGNORECASE)
 
 

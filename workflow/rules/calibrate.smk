@@ -54,5 +54,29 @@ rule calibration_check:
         " --out {output} > {log} 2>&1"
 
 
+rule calibration_check_hydrocode:
+    input:
+        emulator=f"{RESULTS}/emulator/emulator.json",
+        design=f"{RESULTS}/check/design.parquet",
+        features=expand(f"{RESULTS}/check/features/{{shot}}.parquet", shot=SHOTS),
+    output:
+        f"{RESULTS}/posterior/coverage_hydrocode.parquet",
+    params:
+        calibration=config["calibration"],
+        sd_fraction=config["observed"]["sd_fraction"],
+        seed=config["study"]["seed"],
+        emulator_dir=f"{RESULTS}/emulator",
+        pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
+    log:
+        log_file("calibrate/coverage_hydrocode"),
+    benchmark:
+        benchmark_file("calibrate/coverage_hydrocode")
+    conda:
+        "../envs/shockcal.yaml"
+    shell:
+        "shockcal calibrate-check --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {SHOTS}"
+        " --truth-design {input.design} --truth-features {params.pairs} --out {output} > {log} 2>&1"
+
+
 ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)
-ALL_TARGETS.append(f"{RESULTS}/posterior/coverage.parquet")
+ALL_TARGETS += [f"{RESULTS}/posterior/coverage.parquet", f"{RESULTS}/posterior/coverage_hydrocode.parquet"]

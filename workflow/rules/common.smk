@@ -1,4 +1,5 @@
 # Shared helpers of the rule files: the effective config, chunking, config slices.
+import hashlib
 import os
 import sys
 from pathlib import Path
@@ -20,10 +21,12 @@ def _write_if_changed(path, text):
 # that environment is not activated (`.venv/bin/snakemake ...`); a conda env, when used, comes first.
 os.environ["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
 
-# The merged config (configfile + --configfile + --config) that every shockcal call reads. It is
-# not a rule input: reruns follow each rule's params slice, never this file's mtime.
-EFFECTIVE_CONFIG = f"{RESULTS}/config/effective.yaml"
-_write_if_changed(EFFECTIVE_CONFIG, yaml.safe_dump(config, sort_keys=True))
+# The merged config (configfile + --configfile + --config) that every shockcal call reads, named by
+# its content so a dry run with other settings never rewrites the file running jobs read. It is not
+# a rule input: reruns follow each rule's params slice, never this file's mtime.
+_EFFECTIVE_TEXT = yaml.safe_dump(config, sort_keys=True)
+EFFECTIVE_CONFIG = f"{RESULTS}/config/effective-{hashlib.sha256(_EFFECTIVE_TEXT.encode()).hexdigest()[:12]}.yaml"
+_write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
 CHUNK_DIGESTS = chunk_fingerprints(planned_design(config), CHUNK_SIZE)

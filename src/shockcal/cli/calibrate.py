@@ -13,12 +13,15 @@ def register(subparsers) -> None:
     p.add_argument("--n-samples", type=int, help="override the retained sample count")
     p.set_defaults(func=run)
 
-    c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on emulator-generated synthetic truth")
+    c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
     c.add_argument("--config", required=True)
     c.add_argument("--emulator", required=True)
     c.add_argument("--shots", required=True, nargs="+")
     c.add_argument("--out", required=True, help="coverage table (Parquet), one row per trial and parameter")
     c.add_argument("--trials", type=int, help="override calibration.check.trials")
+    c.add_argument("--truth-design", help="hydrocode truth: design table of the truth runs (CSV or Parquet)")
+    c.add_argument("--truth-features", nargs="+", metavar="SHOT=TABLE",
+                   help="hydrocode truth: the features of the truth runs per shot (with --truth-design)")
     c.set_defaults(func=run_check)
 
 
@@ -61,8 +64,33 @@ def run_check(args) -> int:
     from shockcal.io import write_table
 
     config = load_config(args.config)
-    table, coverage = coverage_check(Emulator.load(args.emulator), args.shots, config, trials=args.trials)
-    write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots})
+    truths = hydro_truths(args)
+    table, coverage = coverage_check(Emulator.load(args.emulator), args.shots, config, trials=args.trials,
+                                     truths=truths)
+    source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
+    write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
     logging.getLogger("shockcal.calibrate").info("coverage of nominal 90%% intervals:\n%s",
                                                   coverage.to_string(index=False, float_format="%.3f"))
     return 0
+
+
+def hydro_truths(args):
+    """The hydrocode truth runs named on the command line, or None (emulator truth)."""
+    from shockcal.calibration import HydroTruths
+    from shockcal.errors import InputError
+    from shockcal.io import read_table
+
+    if not args.truth_design and not args.truth_features:
+        return None
+    if not (args.truth_design and args.truth_features):
+        raise InputError("calibrate-check: --truth-design and --truth-features go together")
+    features = {}
+    for pair in args.truth_features:
+        shot, sep, path = pair.partition("=")
+        if not sep:
+            raise InputError(f"calibrate-check: --truth-features takes SHOT=TABLE pairs, got '{pair}'")
+        features[shot] = read_table(path)
+    missing = sorted(set(args.shots) - set(features))
+    if missing:
+        raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
+    return HydroTruths(read_table(args.truth_design), features)

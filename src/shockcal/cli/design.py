@@ -9,6 +9,8 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="output Parquet design table")
     p.add_argument("--n-runs", type=int, default=None, help="override design.n_runs")
     p.add_argument("--seed", type=int, default=None, help="override study.seed")
+    p.add_argument("--lhs", action="store_true",
+                   help="a Latin hypercube over the box even when the config names a design file")
     p.set_defaults(func=run)
 
 
@@ -21,7 +23,7 @@ def run(args) -> int:
 
     config = load_config(args.config)
     log = logging.getLogger("shockcal.design")
-    if config["design"]["file"]:
+    if config["design"]["file"] and not args.lhs:
         design = load_design(config["design"]["file"], config)
         source = f"file {config['design']['file']}"
         if args.n_runs is not None:

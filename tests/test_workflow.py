@@ -1,0 +1,174 @@
+"""The Snakemake workflow on the quick study: every figure from one command, partial reruns decided
+by config slices (not mtimes), and an interrupted fan-out finishing with identical results.
+
+One quick study (config/quick.yaml, about a minute on 2 idle cores) is run into a temporary results
+directory and shared by the tests of this module; the rerun checks are dry runs against it.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import matplotlib.image
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from shockcal.config import load_config
+from shockcal.plots.catalogue import catalogue
+
+REPO = Path(__file__).resolve().parents[1]
+SNAKEMAKE = str(Path(sys.executable).parent / "snakemake")
+
+
+def snakemake(*args, config_files=(), check=True, **popen):
+    """Run snakemake in the repository with config/quick.yaml plus `config_files` (targets first:
+    --configfile takes every argument after it)."""
+    command = [SNAKEMAKE, *args, "--configfile", "config/quick.yaml", *map(str, config_files)]
+    if popen:
+        return subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                **popen)
+    done = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
+    if check and done.returncode != 0:
+        pytest.fail(f"snakemake {' '.join(args)} failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
+    return done
+
+
+def overlay(path: Path, **sections) -> Path:
+    path.write_text(yaml.safe_dump(sections))
+    return path
+
+
+def pending_jobs(*config_files) -> dict[str, int]:
+    """Rule -> number of jobs a dry run of `all` would execute (empty when nothing is to be done)."""
+    out = snakemake("all", "--dry-run", config_files=config_files).stdout
+    if "Job stats:" not in out:
+        assert "Nothing to be done" in out, out[-2000:]
+        return {}
+    table = out.split("Job stats:")[1].splitlines()
+    jobs = {}
+    for line in table[3:]:
+        name, _, count = line.rpartition(" ")
+        if name.strip() == "total":
+            break
+        jobs[name.strip()] = int(count)
+    return jobs
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """The quick study run once, end to end: (results directory, its config overlay)."""
+    root = tmp_path_factory.mktemp("quick")
+    results = root / "results"
+    config = overlay(root / "results.yaml", study={"results_dir": str(results)})
+    snakemake("all", "--cores", "2", config_files=[config])
+    return results, config
+
+
+def test_every_figure_is_a_real_image(study):
+    results, _ = study
+    config = load_config(REPO / "config" / "config.yaml")
+    names = list(catalogue(config))
+    assert len(names) == 15
+    for name in names:
+        png, pdf = results / "figures" / f"{name}.png", results / "figures" / f"{name}.pdf"
+        image = matplotlib.image.imread(png)
+        assert image.shape[0] > 300 and image.shape[1] > 300, name
+        assert np.std(image[..., :3]) > 0.05, f"{name} is (nearly) blank"
+        assert pdf.read_bytes()[:5] == b"%PDF-", name
+
+
+def test_study_products(study):
+    results, _ = study
+    for shot in ("104S", "105S", "106S"):
+        features = pd.read_parquet(results / "features" / f"{shot}.parquet")
+        assert len(features) == 40 and (features["status"] == "ok").mean() >= 0.95
+    for name in ("104S", "105S", "106S", "joint"):
+        summary = pd.read_parquet(results / "posterior" / f"{name}_summary.parquet")
+        assert {"mean", "sd", "r_hat"} <= set(summary.columns), summary.columns
+    cv = pd.read_parquet(results / "emulator" / "cv.parquet")
+    assert len(cv) == 40 * 12
+
+
+def test_report(study, tmp_path):
+    results, config = study
+    report = tmp_path / "report.html"
+    snakemake("all", "--report", str(report), config_files=[config])
+    text = report.read_text(errors="replace")
+    assert "fig07_marginals" in text and "fig11_history_104S" in text
+
+
+def test_nothing_to_redo(study):
+    assert pending_jobs(study[1]) == {}
+
+
+def test_mcmc_setting_reruns_no_simulation(study, tmp_path):
+    jobs = pending_jobs(study[1], overlay(tmp_path / "mcmc.yaml", calibration={"walkers": 40}))
+    assert jobs.get("calibrate") == 4
+    assert not {"design", "simulate", "features", "emulator"} & set(jobs), jobs
+
+
+def test_physics_setting_reruns_every_simulation(study, tmp_path):
+    jobs = pending_jobs(study[1], overlay(tmp_path / "physics.yaml", hydro={"q_linear": 0.12}))
+    assert jobs["simulate"] == 12 and jobs["features"] == 3 and jobs["emulator"] == 1
+    assert "design" not in jobs
+
+
+def test_added_design_rows_run_only_new_chunks(study, tmp_path):
+    results, config = study
+    design = pd.read_parquet(results / "design.parquet")
+    extra = design.tail(10).copy()
+    extra["run"] += 10
+    extra["A"] *= 0.9
+    grown = tmp_path / "design.parquet"
+    pd.concat([design, extra]).to_parquet(grown)
+    jobs = pending_jobs(config, overlay(tmp_path / "grown.yaml", design={"file": str(grown)}))
+    assert jobs["simulate"] == 3                               # chunk 4 of each shot
+    assert jobs["features"] == 3 and jobs["emulator"] == 1
+
+
+def test_added_shot_runs_only_its_simulations(study, tmp_path):
+    quick = load_config(REPO / "config" / "config.yaml")
+    new_shot = dict(quick["shots"]["106S"], target_mm=4.0)
+    observed = dict(quick["observed"]["features"]["106S"])
+    more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"features": {"107S": observed}})
+    jobs = pending_jobs(study[1], more)
+    assert jobs["simulate"] == 4                               # the 4 chunks of 107S only
+    assert jobs["features"] == 1
+
+
+def test_bad_config_is_rejected_before_any_job(tmp_path):
+    bad = overlay(tmp_path / "bad.yaml", simulate={"chunk_size": 0})
+    done = snakemake("all", "--dry-run", config_files=[bad], check=False)
+    assert done.returncode != 0
+    assert "simulate.chunk_size" in done.stdout + done.stderr
+
+
+def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path):
+    results, _ = study
+    resumed = tmp_path / "results"
+    config = overlay(tmp_path / "resumed.yaml", study={"results_dir": str(resumed)})
+    target = resumed / "features" / "104S.parquet"
+    chunks = resumed / "simulations" / "104S"
+    run = snakemake(str(target), "--cores", "1", config_files=[config], start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not (chunks / "chunk-0.parquet").exists() and time.monotonic() < deadline and run.poll() is None:
+        time.sleep(0.1)
+    os.killpg(run.pid, signal.SIGINT)                           # Ctrl-C in the middle of the fan-out
+    run.communicate(timeout=120)
+    finished = sorted(p.name for p in chunks.glob("chunk-*.parquet"))
+    assert 1 <= len(finished) < 4 and not target.exists(), finished
+
+    snakemake(str(target), "--cores", "2", config_files=[config])
+    for k in range(4):
+        ours = pd.read_parquet(chunks / f"chunk-{k}.parquet").drop(columns="wall_time_s")
+        reference = pd.read_parquet(results / "simulations" / "104S" / f"chunk-{k}.parquet").drop(columns="wall_time_s")
+        pd.testing.assert_frame_equal(ours, reference, check_exact=True)
+    pd.testing.assert_frame_equal(pd.read_parquet(target), pd.read_parquet(results / "features" / "104S.parquet"),
+                                  check_exact=True)
