@@ -1,16 +1,15 @@
 # shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
-from snakemake.utils import validate
-
-from shockcal.config import check_semantics
+from shockcal.config import validate_config
 
 
 configfile: "config/config.yaml"
 
 
-validate(config, schema="workflow/schemas/config.schema.yaml")
-check_semantics(config, source="config")
+# snakemake's `validate` against workflow/schemas/config.schema.yaml (defaults filled in), then the
+# cross-field rules; errors name the key path: "config: simulate.chunk_size: 0 is less than ..."
+validate_config(config, source="config")
 
 RESULTS = config["study"]["results_dir"]
 SHOTS = list(config["shots"])

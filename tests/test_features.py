@@ -45,7 +45,7 @@ def quantile_tolerance(sd, p, n):
 # Exact answers of the construction (time us, velocity m/s, time tolerance us). The GMM features are
 # quantiles of one Gaussian estimated from its share of the 10,000 PIT samples: 5 sampling sd
 # (0.81 ns for jump-off/elastic, 3.3 ns for the slope points) cannot fail by chance, while a wrong
-# quantile level (e.g. 0.05 for 0.1: 7 ns) or a wrong component split (tens of ns) is caught.
+# quantile level (e.g. 0.05 for 0.1: 15 ns) or a wrong component split (tens of ns) is caught.
 # Velocity tolerances are the curve's slope times the time tolerance (0.30 and 1.9 m/s).
 EXPECTED = {
     "jumpoff": (T1 + S1 * norm.ppf(0.01), 0.01 * V1, quantile_tolerance(S1, 0.01, N_EARLY)),
@@ -123,8 +123,8 @@ def test_noise_moves_plateaus_by_at_most_two_m_s(settings, plateau):
     assert abs(np.mean(shifts)) <= 2.0
 
 
-def write_trace(path, header, rows, sep=","):
-    path.write_text("\n".join([*header, *(sep.join(str(x) for x in row) for row in rows)]) + "\n")
+def write_trace(path, header, table, sep=","):
+    path.write_text("\n".join([*header, *(sep.join(str(x) for x in row) for row in table)]) + "\n")
     return path
 
 

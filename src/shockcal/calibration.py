@@ -101,7 +101,8 @@ def sample(problem: Problem, n_samples: int, settings: dict, seed: int) -> tuple
     """Run the ensemble; return retained samples (theta, lambda_y, log_post, chain, step) and run info."""
     rng = np.random.default_rng(seed)
     chains = run_ensemble(problem.log_posterior, problem.initial_walkers(settings["walkers"], rng), n_samples,
-                          settings["burn_in_steps"], settings["thin"], settings["mode_hop_fraction"], seed)
+                          settings["burn_in_steps"], settings["thin"], settings["mode_hop_fraction"], seed,
+                          bounds=(problem.lower, problem.upper))
     walkers, steps, ndim = chains.samples.shape
     frame = pd.DataFrame(chains.samples.reshape(-1, ndim), columns=[*problem.names, "log_lambda_y"])
     frame["lambda_y"] = np.exp(frame.pop("log_lambda_y"))

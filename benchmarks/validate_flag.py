@@ -1,0 +1,129 @@
+"""Our hydrocode + feature extractor against the paper's FLAG features (`make validate`).
+
+Simulates design runs 0..N-1 of the paper's design (../shared/data/al5083/design.csv) with the paper
+config, extracts their features with `features_table` (the `shockcal features` code path and seeds),
+and prints per shot and feature the RMSE and bias (ours - FLAG) against flag_features_<shot>.csv,
+in m/s and ns, next to the goals: RMSE <= 3 m/s for the elastic and plastic plateaus, <= 6 m/s for
+the slope points, and jump-off time within 0.5% once the constant offset between the codes' clocks
+is removed. Then the features of the measured records against the published ones. Two processes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from multiprocessing import Pool
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from shockcal.cli.features import SEED_OFFSET, record_features
+from shockcal.config import load_config
+from shockcal.errors import InputError
+from shockcal.features import COLUMNS, features_table
+from shockcal.reference import require_reference_dir
+from shockcal.simulate import simulate_design
+
+CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
+SHOTS = ["104S", "105S", "106S"]
+FLAG_RUNS = 500  # FLAG features exist for runs 0-499
+CHUNK = 5        # design rows per task
+PROCESSES = 2
+RMSE_GOALS_M_S = {"v_elastic": 3.0, "v_plastic": 3.0, "v_slope1": 6.0, "v_slope2": 6.0}
+JUMPOFF_GOAL_PERCENT = 0.5
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=100, help="design runs 0..N-1 per shot (default 100, at most 500)")
+    parser.add_argument("--shots", nargs="+", default=SHOTS, choices=SHOTS)
+    args = parser.parse_args(argv)
+    if not 1 <= args.runs <= FLAG_RUNS:
+        parser.error(f"--runs must be between 1 and {FLAG_RUNS} (the FLAG runs)")
+    return args
+
+
+def simulate_chunk(task) -> pd.DataFrame:
+    """Features of one chunk of design rows for one shot (runs in a worker process, one thread)."""
+    from threadpoolctl import threadpool_limits
+
+    shot, rows, config = task
+    with threadpool_limits(1):
+        traces = simulate_design(rows, config, shot)
+        return features_table(traces, config, shot, config["study"]["seed"] + SEED_OFFSET).assign(shot=shot)
+
+
+def compare(ours: pd.DataFrame, flag: pd.DataFrame) -> pd.DataFrame:
+    """RMSE and bias (ours - FLAG) per feature over the runs with features: m/s and ns."""
+    ok = ours[ours["status"] == "ok"].set_index("run")
+    diff = ok[COLUMNS] - flag.loc[ok.index, COLUMNS]
+    scale = pd.Series({c: 1e3 if c.startswith("t_") else 1.0 for c in COLUMNS})
+    diff = diff * scale
+    return pd.DataFrame({"unit": ["ns" if c.startswith("t_") else "m/s" for c in COLUMNS],
+                         "rmse": np.sqrt((diff ** 2).mean()), "bias": diff.mean()})
+
+
+def jumpoff_after_offset(ours: pd.DataFrame, flag: pd.DataFrame) -> tuple[float, float]:
+    """Jump-off time RMSE (ns) once the mean offset is removed, and as % of FLAG's mean jump-off time."""
+    ok = ours[ours["status"] == "ok"].set_index("run")
+    diff = ok["t_jumpoff"] - flag.loc[ok.index, "t_jumpoff"]
+    rmse = float(np.sqrt(((diff - diff.mean()) ** 2).mean()))
+    return 1e3 * rmse, 100 * rmse / float(flag.loc[ok.index, "t_jumpoff"].mean())
+
+
+def print_shot(shot: str, ours: pd.DataFrame, flag: pd.DataFrame) -> None:
+    failed = ours[ours["status"] != "ok"]
+    print(f"\nshot {shot}: {len(ours)} runs, {len(ours) - len(failed)} with features")
+    for row in failed.itertuples():
+        print(f"  run {row.run} failed: {row.reason}")
+    table = compare(ours, flag)
+    print(f"  {'feature':11}{'unit':>5}{'RMSE':>9}{'bias':>9}   goal (RMSE)")
+    for column, row in table.iterrows():
+        goal = RMSE_GOALS_M_S.get(column)
+        verdict = "" if goal is None else f"<= {goal:.0f} m/s  {'met' if row.rmse <= goal else 'NOT met'}"
+        print(f"  {column:11}{row.unit:>5}{row.rmse:9.2f}{row.bias:+9.2f}   {verdict}")
+    rmse_ns, percent = jumpoff_after_offset(ours, flag)
+    print(f"  jump-off time without its offset ({table.loc['t_jumpoff', 'bias']:+.1f} ns): RMSE {rmse_ns:.2f} ns = "
+          f"{percent:.2f}% of FLAG's   goal <= {JUMPOFF_GOAL_PERCENT}%  "
+          f"{'met' if percent <= JUMPOFF_GOAL_PERCENT else 'NOT met'}")
+
+
+def print_records(config: dict, ref: Path, shots) -> None:
+    """Measured records' features against the published ones (ours - published), m/s and ns."""
+    published = pd.read_csv(ref / "observed_features.csv").set_index("shot")
+    print("\nmeasured records vs published features (ours - published; m/s, ns)")
+    print("  shot " + "".join(f"{c:>11}" for c in COLUMNS))
+    for shot in shots:
+        ours = record_features(config, shot, ref / "visar" / f"Data_S{shot}.txt")
+        print(f"  {shot} " + "".join(f"{(ours[c] - published.loc[shot, c]) * (1e3 if c.startswith('t_') else 1):+11.2f}"
+                                     for c in COLUMNS))
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    try:
+        ref = require_reference_dir()
+    except InputError as exc:
+        print(f"validate_flag: {exc}", file=sys.stderr)
+        return 2
+    config = load_config(CONFIG)
+    design = pd.read_csv(ref / "design.csv").iloc[: args.runs]
+    tasks = [(shot, design.iloc[i: i + CHUNK], config) for shot in args.shots for i in range(0, args.runs, CHUNK)]
+    print(f"{args.runs} design runs x {len(args.shots)} shots on {PROCESSES} processes "
+          f"(hydro {config['hydro']['cell_size_um']} um, {config['hydro']['end_time_us']} us)")
+    start = time.perf_counter()
+    with Pool(PROCESSES) as pool:
+        ours = pd.concat(pool.imap_unordered(simulate_chunk, tasks), ignore_index=True)
+    wall = time.perf_counter() - start
+    for shot in args.shots:
+        flag = pd.read_csv(ref / f"flag_features_{shot}.csv").set_index("run")
+        print_shot(shot, ours[ours["shot"] == shot].sort_values("run"), flag)
+    print_records(config, ref, args.shots)
+    print(f"\nwall time (simulate + extract): {wall:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
