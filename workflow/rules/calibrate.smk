@@ -3,10 +3,6 @@
 CALIBRATIONS = [*SHOTS, "joint"]
 
 
-def calibration_shots(wildcards):
-    return " ".join(SHOTS if wildcards.name == "joint" else [wildcards.name])
-
-
 rule calibrate:
     input:
         emulator=f"{RESULTS}/emulator/emulator.json",
@@ -20,16 +16,16 @@ rule calibrate:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
         seed=config["study"]["seed"],
-        shots=calibration_shots,
-        emulator_dir=f"{RESULTS}/emulator",
+        shots=lambda w: " ".join(SHOTS if w.name == "joint" else [w.name]),
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     log:
-        log_file("calibrate/{name}"),
+        f"{LOGS}/calibrate/{{name}}.log",
     benchmark:
-        benchmark_file("calibrate/{name}")
+        f"{BENCHMARKS}/calibrate/{{name}}.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal calibrate --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {params.shots}"
+        "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots}"
         " --observed {input.observed} --out {output.samples} > {log} 2>&1"
 
 
@@ -42,15 +38,16 @@ rule calibration_check:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
         seed=config["study"]["seed"],
-        emulator_dir=f"{RESULTS}/emulator",
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+        shots=" ".join(SHOTS),
     log:
-        log_file("calibrate/coverage"),
+        f"{LOGS}/calibrate/coverage.log",
     benchmark:
-        benchmark_file("calibrate/coverage")
+        f"{BENCHMARKS}/calibrate/coverage.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal calibrate-check --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {SHOTS}"
+        "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
         " --out {output} > {log} 2>&1"
 
 
@@ -65,16 +62,17 @@ rule calibration_check_hydrocode:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
         seed=config["study"]["seed"],
-        emulator_dir=f"{RESULTS}/emulator",
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
         pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
+        shots=" ".join(SHOTS),
     log:
-        log_file("calibrate/coverage_hydrocode"),
+        f"{LOGS}/calibrate/coverage_hydrocode.log",
     benchmark:
-        benchmark_file("calibrate/coverage_hydrocode")
+        f"{BENCHMARKS}/calibrate/coverage_hydrocode.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal calibrate-check --config {EFFECTIVE_CONFIG} --emulator {params.emulator_dir} --shots {SHOTS}"
+        "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
         " --truth-design {input.design} --truth-features {params.pairs} --out {output} > {log} 2>&1"
 
 

@@ -9,10 +9,10 @@ rule design:
         inputs=config["inputs"],
         seed=config["study"]["seed"],
     log:
-        log_file("design"),
+        f"{LOGS}/design.log",
     benchmark:
-        benchmark_file("design")
+        f"{BENCHMARKS}/design.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal design --config {EFFECTIVE_CONFIG} --out {output} > {log} 2>&1"
+        "shockcal design --out {output} > {log} 2>&1"

@@ -14,16 +14,16 @@ rule emulator:
         emulator=config["emulator"],
         seed=config["study"]["seed"],
         pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
-        out=f"{RESULTS}/emulator",
+        out=lambda w, output: os.path.dirname(output.emulator),
     log:
-        log_file("emulator"),
+        f"{LOGS}/emulator.log",
     benchmark:
-        benchmark_file("emulator")
+        f"{BENCHMARKS}/emulator.tsv"
     threads: 2
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal emulate --config {EFFECTIVE_CONFIG} --design {input.design} --features {params.pairs}"
+        "shockcal emulate --design {input.design} --features {params.pairs}"
         " --out {params.out} > {log} 2>&1"
 
 

@@ -11,13 +11,13 @@ rule features:
         analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
         max_failed_fraction=config["simulate"]["max_failed_fraction"],
     log:
-        log_file("features/{shot}"),
+        f"{LOGS}/features/{{shot}}.log",
     benchmark:
-        benchmark_file("features/{shot}")
+        f"{BENCHMARKS}/features/{{shot}}.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal features --config {EFFECTIVE_CONFIG} --shot {wildcards.shot} --traces {input} --out {output} > {log} 2>&1"
+        "shockcal features --shot {wildcards.shot} --traces {input} --out {output} > {log} 2>&1"
 
 
 rule observed:
@@ -30,13 +30,13 @@ rule observed:
         features=config["features"],
         analysis={shot: spec.get("analysis", {}) for shot, spec in config["shots"].items()},
     log:
-        log_file("observed"),
+        f"{LOGS}/observed.log",
     benchmark:
-        benchmark_file("observed")
+        f"{BENCHMARKS}/observed.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal observed --config {EFFECTIVE_CONFIG} --out {output} > {log} 2>&1"
+        "shockcal observed --out {output} > {log} 2>&1"
 
 
 ALL_TARGETS += expand(f"{RESULTS}/features/{{shot}}.parquet", shot=SHOTS)

@@ -71,17 +71,17 @@ for _name, _spec in FIGURE_SPECS.items():
         params:
             figure=_name,
             shot=HISTORY_SHOTS.get(_name, ""),
-            out_dir=f"{RESULTS}/figures",
+            out_dir=lambda w, output: os.path.dirname(output[0]),
             inputs=" ".join(f"--input {key}={path}" for key, paths in _files.items() for path in paths),
             figures=config["figures"],
         log:
-            log_file(f"figures/{_name}"),
+            f"{LOGS}/figures/{_name}.log",
         benchmark:
-            benchmark_file(f"figures/{_name}")
+            f"{BENCHMARKS}/figures/{_name}.tsv"
         conda:
             "../envs/shockcal.yaml"
         shell:
-            "shockcal figures --config {EFFECTIVE_CONFIG} --figure {params.figure} --out-dir {params.out_dir}"
+            "shockcal figures --figure {params.figure} --out-dir {params.out_dir}"
             " {params.inputs} > {log} 2>&1"
 
 

@@ -6,13 +6,8 @@
 #            check with hydrocode-made pseudo-measurements (calibrate.smk).
 PREDICT = f"{RESULTS}/predict"
 RUN_SETS = {"predict": config["predict"]["n_posterior_runs"], "check": config["calibration"]["check"]["trials"]}
-
-
-def run_set_chunks(name):
-    return list(range(-(-RUN_SETS[name] // CHUNK_SIZE)))
-
-
-PREDICT_CHUNKS = run_set_chunks("predict")
+RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SETS.items()}
+PREDICT_CHUNKS = RUN_SET_CHUNKS["predict"]
 
 
 rule predict_design:
@@ -24,13 +19,13 @@ rule predict_design:
         predict=config["predict"],
         seed=config["study"]["seed"],
     log:
-        log_file("predict/design"),
+        f"{LOGS}/predict/design.log",
     benchmark:
-        benchmark_file("predict/design")
+        f"{BENCHMARKS}/predict/design.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal predict --config {EFFECTIVE_CONFIG} --posterior {input.posterior} --out {output} > {log} 2>&1"
+        "shockcal predict --posterior {input.posterior} --out {output} > {log} 2>&1"
 
 
 rule check_design:
@@ -41,13 +36,13 @@ rule check_design:
         inputs=config["inputs"],
         seed=config["study"]["seed"] + config["calibration"]["seed_offset"] + 2,
     log:
-        log_file("check/design"),
+        f"{LOGS}/check/design.log",
     benchmark:
-        benchmark_file("check/design")
+        f"{BENCHMARKS}/check/design.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal design --config {EFFECTIVE_CONFIG} --lhs --n-runs {params.trials} --seed {params.seed}"
+        "shockcal design --lhs --n-runs {params.trials} --seed {params.seed}"
         " --out {output} > {log} 2>&1"
 
 
@@ -59,23 +54,23 @@ rule run_set_simulate:
     wildcard_constraints:
         run_set="|".join(RUN_SETS),
     params:
-        physics=lambda w: physics_slice(w.shot),
-        rows=chunk_rows,
+        physics=lambda w: physics_slice(config, w.shot),
+        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
     log:
-        log_file("{run_set}/simulate/{shot}/chunk-{chunk}"),
+        f"{LOGS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
-        benchmark_file("{run_set}/simulate/{shot}/chunk-{chunk}")
+        f"{BENCHMARKS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal simulate --config {EFFECTIVE_CONFIG} --shot {wildcards.shot} --design {input.design}"
+        "shockcal simulate --shot {wildcards.shot} --design {input.design}"
         " --rows {params.rows} --out {output} > {log} 2>&1"
 
 
 rule run_set_features:
     input:
         lambda w: expand(
-            f"{RESULTS}/{w.run_set}/simulations/{w.shot}/chunk-{{chunk}}.parquet", chunk=run_set_chunks(w.run_set)
+            f"{RESULTS}/{w.run_set}/simulations/{w.shot}/chunk-{{chunk}}.parquet", chunk=RUN_SET_CHUNKS[w.run_set]
         ),
     output:
         f"{RESULTS}/{{run_set}}/features/{{shot}}.parquet",
@@ -86,13 +81,13 @@ rule run_set_features:
         analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
         max_failed_fraction=config["simulate"]["max_failed_fraction"],
     log:
-        log_file("{run_set}/features/{shot}"),
+        f"{LOGS}/{{run_set}}/features/{{shot}}.log",
     benchmark:
-        benchmark_file("{run_set}/features/{shot}")
+        f"{BENCHMARKS}/{{run_set}}/features/{{shot}}.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal features --config {EFFECTIVE_CONFIG} --shot {wildcards.shot} --traces {input} --out {output}"
+        "shockcal features --shot {wildcards.shot} --traces {input} --out {output}"
         " > {log} 2>&1"
 
 
@@ -104,13 +99,13 @@ rule predict_emulator:
     output:
         f"{PREDICT}/emulator.parquet",
     params:
-        emulator_dir=f"{RESULTS}/emulator",
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     log:
-        log_file("predict/emulator"),
+        f"{LOGS}/predict/emulator.log",
     benchmark:
-        benchmark_file("predict/emulator")
+        f"{BENCHMARKS}/predict/emulator.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal predict-emulator --config {EFFECTIVE_CONFIG} --design {input.design}"
+        "shockcal predict-emulator --design {input.design}"
         " --emulator {params.emulator_dir} --out {output} > {log} 2>&1"

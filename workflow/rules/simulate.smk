@@ -9,15 +9,15 @@ rule simulate:
     output:
         f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
     params:
-        physics=lambda w: physics_slice(w.shot),
-        rows=chunk_rows,
+        physics=lambda w: physics_slice(config, w.shot),
+        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
         rows_digest=lambda w: CHUNK_DIGESTS[int(w.chunk)],
     log:
-        log_file("simulate/{shot}/chunk-{chunk}"),
+        f"{LOGS}/simulate/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
-        benchmark_file("simulate/{shot}/chunk-{chunk}")
+        f"{BENCHMARKS}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal simulate --config {EFFECTIVE_CONFIG} --shot {wildcards.shot} --design {input.design}"
+        "shockcal simulate --shot {wildcards.shot} --design {input.design}"
         " --rows {params.rows} --out {output} > {log} 2>&1"

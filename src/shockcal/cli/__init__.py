@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 
 from shockcal import __version__
@@ -25,6 +26,13 @@ STAGE_MODULES = [
     "shockcal.cli.predict",
     "shockcal.cli.figures",
 ]
+
+
+def add_config_argument(parser, help: str = "study config YAML") -> None:
+    """`--config`, defaulting to $SHOCKCAL_CONFIG (the workflow sets it to the merged config)."""
+    default = os.environ.get("SHOCKCAL_CONFIG")
+    parser.add_argument("--config", default=default, required=default is None,
+                        help=f"{help} (default: $SHOCKCAL_CONFIG)")
 
 
 def build_parser() -> argparse.ArgumentParser:

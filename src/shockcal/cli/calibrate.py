@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_config_argument
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("calibrate", help="MCMC posterior of the inputs given measured features")
-    p.add_argument("--config", required=True, help="study config YAML")
+    add_config_argument(p, "study config YAML")
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
     p.add_argument("--observed", required=True, help="observed features table (CSV or Parquet: shot + feature columns)")
@@ -14,7 +16,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
     c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
-    c.add_argument("--config", required=True)
+    add_config_argument(c)
     c.add_argument("--emulator", required=True)
     c.add_argument("--shots", required=True, nargs="+")
     c.add_argument("--out", required=True, help="coverage table (Parquet), one row per trial and parameter")

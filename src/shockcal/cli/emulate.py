@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_config_argument
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("emulate", help="fit the emulator; write it and its leave-one-out table")
-    p.add_argument("--config", required=True, help="study config YAML")
+    add_config_argument(p, "study config YAML")
     p.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
                    help="per-shot feature tables (CSV or Parquet), joined to the design on `run`")

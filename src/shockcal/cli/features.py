@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_config_argument
+
 import logging
 
 log = logging.getLogger("shockcal.features")
@@ -11,7 +13,7 @@ UNITS = {"t_*": "us", "v_*": "m/s"}
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("features", help="extract the features of simulated traces or of a measured record")
-    p.add_argument("--config", required=True, help="study config YAML")
+    add_config_argument(p, "study config YAML")
     p.add_argument("--shot", required=True, help="shot name (its analysis window is in the config)")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--traces", nargs="+", help="simulation tables (Parquet or CSV) from `shockcal simulate`")
@@ -22,7 +24,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
     o = subparsers.add_parser("observed", help="write the measured features of every shot (config values or records)")
-    o.add_argument("--config", required=True)
+    add_config_argument(o)
     o.add_argument("--out", required=True)
     o.set_defaults(func=run_observed)
 

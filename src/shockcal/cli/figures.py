@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_config_argument
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("figures", help="draw one figure of the study as PNG/PDF (see --list)")
-    p.add_argument("--config", required=True, help="study config YAML (figures.formats, figures.dpi)")
+    add_config_argument(p, "study config YAML (figures.formats, figures.dpi)")
     p.add_argument("--figure", help="figure name, e.g. fig07_marginals")
     p.add_argument("--out-dir", default="results/figures", help="folder for <figure>.<format>")
     p.add_argument("--input", action="append", default=[], metavar="KEY=PATH",

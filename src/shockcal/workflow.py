@@ -1,0 +1,42 @@
+"""Helpers of the Snakemake rule files (kept here so the rule files hold rules only)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def write_if_changed(path, text: str) -> None:
+    """Write `path` only when its content changes (every job re-reads the Snakefile)."""
+    path = Path(path)
+    if not path.exists() or path.read_text() != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+
+
+def chunk_rows(chunk, chunk_size: int) -> str:
+    """The design-row slice of one chunk, as `shockcal simulate --rows` takes it."""
+    start = int(chunk) * chunk_size
+    return f"{start}:{start + chunk_size}"
+
+
+def chunk_count(n_runs: int, chunk_size: int) -> int:
+    return -(-n_runs // chunk_size)
+
+
+def physics_slice(config: dict, shot: str) -> dict:
+    """What a hydrocode run of `shot` depends on besides its design rows."""
+    spec = config["shots"][shot]
+    geometry = {k: spec[k] for k in ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")}
+    return {"material": config["material"], "hydro": config["hydro"], "shot": geometry}
+
+
+def export_to_jobs(effective_config: str) -> None:
+    """Environment every job inherits: the merged config as $SHOCKCAL_CONFIG (the default of
+    `shockcal --config`), and the directory of the Python running snakemake first on PATH, so rules
+    find the `shockcal` script even when that environment is not activated (`.venv/bin/snakemake`);
+    a conda env, when used, is activated in front of it."""
+    import os
+    import sys
+
+    os.environ["SHOCKCAL_CONFIG"] = effective_config
+    os.environ["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
