@@ -83,6 +83,17 @@ def test_known_answers_of_a_two_step_trace(settings, seed):
     assert f["v_elastic"] < f["v_slope1"] < f["v_slope2"] < f["v_plastic"]
 
 
+def test_a_weak_precursor_of_a_trace_at_rest_is_the_arrival(paper_config):
+    """Small A or m near 0 (106S): a 6 m/s precursor 0.1 us ahead of a 470 m/s plastic wave, below
+    the 2% arrival level a noisy record needs. A trace exactly at rest before it (a simulation)
+    takes the precursor as the arrival, so the elastic plateau is the precursor, not the wave."""
+    v = 6.0 * norm.cdf((T - 0.90) / 0.004) + 464.0 * norm.cdf((T - 1.00) / 0.01)
+    f = extract_features(T, v, paper_config["shots"]["106S"]["analysis"], paper_config["features"])
+    assert f["t_jumpoff"] == pytest.approx(0.90 + 0.004 * norm.ppf(0.01), abs=1e-3)
+    assert f["v_elastic"] == pytest.approx(6.0 * 0.99, abs=0.1)
+    assert f["v_plastic"] > 460
+
+
 def test_same_seed_is_bit_identical_and_seeds_differ_slightly(settings):
     v = trace()
     first, again, other = features(v, settings, 5), features(v, settings, 5), features(v, settings, 6)

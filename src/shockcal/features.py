@@ -2,7 +2,11 @@
 
 1. Baseline and arrival: the baseline is the median of the trace before the rise and the noise
    level its robust spread; the arrival is the first time the trace exceeds the baseline by
-   `ARRIVAL_FRACTION` of the total rise (or 5 noise sd, whichever is larger).
+   `ARRIVAL_FRACTION` of the total rise (or 5 noise sd, whichever is larger). A trace exactly at
+   rest before the rise (a simulation: zero baseline, zero spread; a record's constant pre-trigger
+   offset is not zero) uses `QUIET_ARRIVAL_FRACTION` instead, so that a
+   weak precursor (small A, or m near 0: a few m/s ahead of a 500 m/s plastic wave) is the arrival
+   rather than the plastic wave behind it.
 2. Analysis window: from `PRE_ARRIVAL_US` before the arrival to `window_after_arrival_us` after it
    (per shot in config; it must end before the release from the flyer's back reaches the free
    surface). Measured records carry pre-trigger content and a baseline offset: both are outside
@@ -27,6 +31,7 @@ from scipy import optimize, stats
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
 ARRIVAL_FRACTION = 0.02
+QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0
 PRE_ARRIVAL_US = 0.05
 PLASTIC_LEVEL = 0.995
@@ -84,7 +89,9 @@ def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
     """First time the trace rises above its baseline by a small share of the rise (or the noise)."""
     baseline, noise = baseline_and_noise(t, v)
     rise = v.max() - baseline
-    threshold = max(ARRIVAL_FRACTION * rise, NOISE_MULTIPLE * noise)
+    at_rest = baseline == 0.0 and noise == 0.0
+    fraction = QUIET_ARRIVAL_FRACTION if at_rest else ARRIVAL_FRACTION
+    threshold = max(fraction * rise, NOISE_MULTIPLE * noise)
     if rise <= 2 * threshold or rise <= 0:
         raise FeatureError(f"no rise above the baseline (rise {rise:.3g} m/s, noise {noise:.3g} m/s)")
     return float(t[np.argmax(v - baseline > threshold)])
