@@ -94,6 +94,15 @@ def test_a_weak_precursor_of_a_trace_at_rest_is_the_arrival(paper_config):
     assert f["v_plastic"] > 460
 
 
+def test_a_single_wave_still_has_ordered_features(settings):
+    """Large A in 104S: the elastic wave is the whole rise (no plastic wave behind it)."""
+    v = 200.0 * norm.cdf((T - 0.92) / 0.006)
+    f = features(v, settings)
+    assert f["t_jumpoff"] < f["t_elastic"] <= f["t_plastic"]
+    assert f["t_slope1"] < f["t_slope2"]
+    assert f["v_slope2"] <= f["v_plastic"] <= 200.0 and f["v_plastic"] >= 0.99 * 200.0
+
+
 def test_same_seed_is_bit_identical_and_seeds_differ_slightly(settings):
     v = trace()
     first, again, other = features(v, settings, 5), features(v, settings, 5), features(v, settings, 6)

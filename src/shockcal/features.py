@@ -16,6 +16,9 @@
    through the inverse CDF, linear interpolation of (y, t)).
 4. A k = 5 Gaussian mixture (scikit-learn, seeded) is fitted; components with mu + 2 sigma < c,
    c = arrival + `cutoff_after_arrival_us`, form the early (elastic) mixture, the rest the late one.
+   A trace with a single wave (elastic only at large A, or a precursor merged with the plastic
+   rise) puts every component on one side: then the latest (resp. earliest) component is taken as
+   the late (early) mixture, so every run of the design box has features, as FLAG's had.
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time.
@@ -120,9 +123,10 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     mixture = Mixture(gm.weights_, gm.means_.ravel(), np.sqrt(gm.covariances_.ravel()))
     cutoff = arrival + cutoff_after_arrival_us
     early = mixture.means + 2 * mixture.sds < cutoff
-    if not early.any() or early.all():
-        raise FeatureError(f"the mixture has no {'early' if not early.any() else 'late'} component "
-                           f"(cut-off {cutoff:.3f} us; component means {np.round(mixture.means, 3).tolist()} us)")
+    if early.all():          # one wave only (elastic, large A): its latest component is the late mixture
+        early[np.argmax(mixture.means)] = False
+    elif not early.any():    # the precursor merges with the plastic rise: its earliest component is early
+        early[np.argmin(mixture.means)] = True
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
     times = {"jumpoff": early_mix.quantile(0.01), "elastic": early_mix.quantile(0.99),
              "slope1": late_mix.quantile(0.1), "slope2": late_mix.quantile(0.9),
