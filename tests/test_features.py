@@ -101,6 +101,8 @@ def test_a_single_wave_still_has_ordered_features(settings):
     assert f["t_jumpoff"] < f["t_elastic"] <= f["t_plastic"]
     assert f["t_slope1"] < f["t_slope2"]
     assert f["v_slope2"] <= f["v_plastic"] <= 200.0 and f["v_plastic"] >= 0.99 * 200.0
+    assert f["t_elastic"] <= f["t_slope1"] and f["v_elastic"] <= f["v_slope1"]   # on the top, as FLAG's
+    assert f["v_elastic"] >= 0.9 * 200.0
 
 
 def test_same_seed_is_bit_identical_and_seeds_differ_slightly(settings):

@@ -18,7 +18,8 @@
    c = arrival + `cutoff_after_arrival_us`, form the early (elastic) mixture, the rest the late one.
    A trace with a single wave (elastic only at large A, or a precursor merged with the plastic
    rise) puts every component on one side: then the latest (resp. earliest) component is taken as
-   the late (early) mixture, so every run of the design box has features, as FLAG's had.
+   the late (early) mixture, so every run of the design box has features, as FLAG's had; the slope
+   times are kept at or after the elastic time (FLAG's single-wave runs have all points on the top).
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time.
@@ -128,8 +129,10 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     elif not early.any():    # the precursor merges with the plastic rise: its earliest component is early
         early[np.argmin(mixture.means)] = True
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
-    times = {"jumpoff": early_mix.quantile(0.01), "elastic": early_mix.quantile(0.99),
-             "slope1": late_mix.quantile(0.1), "slope2": late_mix.quantile(0.9),
+    elastic = early_mix.quantile(0.99)
+    slope1 = max(late_mix.quantile(0.1), elastic)     # a single wave's broad last component can reach back
+    times = {"jumpoff": early_mix.quantile(0.01), "elastic": elastic,
+             "slope1": slope1, "slope2": max(late_mix.quantile(0.9), slope1),
              "plastic": float(tw[np.argmax(y >= PLASTIC_LEVEL)])}
     features = {}
     for name in FEATURES:
