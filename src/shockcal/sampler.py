@@ -9,8 +9,9 @@ that mode. Halfway through burn-in, walkers stranded far below the ensemble in l
 never accepting) restart from copies of other walkers; this happens during burn-in only, so the
 retained draws are an ordinary MCMC run.
 
-After burn-in a Gaussian mixture (scikit-learn, components chosen by BIC) is fitted to the second
-half of the burn-in draws, and the retained draws come mostly from an independence
+Burn-in runs in thirds: ensemble moves; ensemble moves whose draws fit a Gaussian mixture
+(scikit-learn, components chosen by BIC, in the logits of the box); the mixture's own moves, whose
+draws refit it. The retained draws come mostly from an independence
 Metropolis-Hastings move that proposes from that mixture, widened and mixed with one broad
 "defensive" Gaussian (Hesterberg 1995) so that no region the burn-in missed has zero proposal
 density. The proposal is fixed before the retained draws start, so they are an ordinary MCMC run

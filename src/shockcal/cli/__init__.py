@@ -15,7 +15,7 @@ import os
 import sys
 
 from shockcal import __version__
-from shockcal.errors import ShockcalError
+from shockcal.errors import InputError, ShockcalError
 
 STAGE_MODULES = [
     "shockcal.cli.design",
@@ -33,6 +33,17 @@ def add_config_argument(parser, help: str = "study config YAML") -> None:
     default = os.environ.get("SHOCKCAL_CONFIG")
     parser.add_argument("--config", default=default, required=default is None,
                         help=f"{help} (default: $SHOCKCAL_CONFIG)")
+
+
+def parse_pairs(pairs: list[str], option: str) -> dict[str, str]:
+    """['104S=a.parquet', ...] -> {'104S': 'a.parquet', ...}; a malformed pair is an InputError."""
+    parsed = {}
+    for pair in pairs:
+        key, sep, path = pair.partition("=")
+        if not sep or not key or not path:
+            raise InputError(f"{option}: '{pair}' is not SHOT=FILE")
+        parsed[key] = path
+    return parsed
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_config_argument, parse_pairs
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("calibrate", help="MCMC posterior of the inputs given measured features")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
     p.add_argument("--observed", required=True, help="observed features table (CSV or Parquet: shot + feature columns)")
@@ -86,12 +86,7 @@ def hydro_truths(args):
         return None
     if not (args.truth_design and args.truth_features):
         raise InputError("calibrate-check: --truth-design and --truth-features go together")
-    features = {}
-    for pair in args.truth_features:
-        shot, sep, path = pair.partition("=")
-        if not sep:
-            raise InputError(f"calibrate-check: --truth-features takes SHOT=TABLE pairs, got '{pair}'")
-        features[shot] = read_table(path)
+    features = {shot: read_table(path) for shot, path in parse_pairs(args.truth_features, "--truth-features").items()}
     missing = sorted(set(args.shots) - set(features))
     if missing:
         raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")

@@ -7,7 +7,7 @@ from shockcal.cli import add_config_argument
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("design", help="write the design table (seeded Latin hypercube or the config's design file)")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--out", required=True, help="output Parquet design table")
     p.add_argument("--n-runs", type=int, default=None, help="override design.n_runs")
     p.add_argument("--seed", type=int, default=None, help="override study.seed")

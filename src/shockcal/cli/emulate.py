@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_config_argument, parse_pairs
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("emulate", help="fit the emulator; write it and its leave-one-out table")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
                    help="per-shot feature tables (CSV or Parquet), joined to the design on `run`")
@@ -18,18 +18,6 @@ def register(subparsers) -> None:
     cv = subparsers.add_parser("emulate-cv", help="print the leave-one-out RMSE table of a fitted emulator")
     cv.add_argument("--emulator", required=True, help="emulator directory")
     cv.set_defaults(func=print_cv)
-
-
-def _parse_features(pairs: list[str]) -> dict[str, str]:
-    from shockcal.errors import InputError
-
-    parsed = {}
-    for pair in pairs:
-        shot, sep, path = pair.partition("=")
-        if not sep or not shot or not path:
-            raise InputError(f"--features: '{pair}' is not SHOT=FILE")
-        parsed[shot] = path
-    return parsed
 
 
 def run(args) -> int:
@@ -44,7 +32,7 @@ def run(args) -> int:
     config = load_config(args.config)
     if args.structure:
         config["emulator"]["structure"] = args.structure
-    paths = _parse_features(args.features)
+    paths = parse_pairs(args.features, "--features")
     for shot in paths:
         shot_config(config, shot)
     design = load_design(args.design, config)

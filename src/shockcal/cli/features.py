@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
-
 import logging
+
+from shockcal.cli import add_config_argument
 
 log = logging.getLogger("shockcal.features")
 SEED_OFFSET = 3  # feature sampling uses study.seed + SEED_OFFSET (+ run id)
@@ -13,7 +13,7 @@ UNITS = {"t_*": "us", "v_*": "m/s"}
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("features", help="extract the features of simulated traces or of a measured record")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--shot", required=True, help="shot name (its analysis window is in the config)")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--traces", nargs="+", help="simulation tables (Parquet or CSV) from `shockcal simulate`")

@@ -7,7 +7,7 @@ from shockcal.cli import add_config_argument
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("predict", help="draw joint-posterior samples as a design table for hydrocode runs")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
     p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
     p.add_argument("--n-runs", type=int, default=None, help="override predict.n_posterior_runs")
@@ -15,7 +15,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
     e = subparsers.add_parser("predict-emulator", help="emulator predictions of the features at a design's rows")
-    add_config_argument(e, "study config YAML")
+    add_config_argument(e)
     e.add_argument("--design", required=True, help="design table, e.g. the posterior draws of `shockcal predict`")
     e.add_argument("--emulator", required=True, help="emulator directory written by `shockcal emulate`")
     e.add_argument("--out", required=True, help="output Parquet table: run, shot, features and their sd (m/s)")

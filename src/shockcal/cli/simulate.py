@@ -7,7 +7,7 @@ from shockcal.cli import add_config_argument
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("simulate", help="run design rows through the hydrocode for one shot")
-    add_config_argument(p, "study config YAML")
+    add_config_argument(p)
     p.add_argument("--shot", required=True, help="shot name in the config, e.g. 104S")
     p.add_argument("--design", required=True, help="design table (CSV or Parquet; Table IV units; `run` kept)")
     p.add_argument("--rows", default=":", help="slice of design row positions, e.g. 0:25 (default: all)")

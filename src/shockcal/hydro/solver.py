@@ -90,7 +90,8 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
     plastic_rate = np.zeros(N + 1)
     hard = np.full(N + 1, hardening(A, B, n, 0.0))
     # a lower bound of each cell's flow stress, valid while its temperature stays <= floor_T:
-    # a trial stress inside it is elastic without evaluating pow/log (see _flow_floor)
+    # a trial stress inside it is elastic without evaluating pow/log (JC rate factor >= 1, thermal
+    # factor falling with T, hardening growing with eps_p)
     flow_floor = np.zeros(N + 1)
     floor_T = np.full(N + 1, np.inf)
     u = np.zeros(N + 2)
@@ -126,7 +127,7 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
         # 2. contact
         closing = length[gap] + dt * (u[gap + 1] - u[gap])
         if closing <= 0.0:
-            _collide(u, node_mass, E, P, sigma, cell_mass, gap, gamma0 * rho0, max(approach_speed, 0.0))
+            _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, max(approach_speed, 0.0))
         length[gap] = max(length[gap] + dt * (u[gap + 1] - u[gap]), 0.0)
         # 3. cells
         max_signal_rate = cfl / dt_max         # (signal speed / cell length), the CFL limit is cfl / max
