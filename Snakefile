@@ -1,15 +1,16 @@
 # shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
-from shockcal.config import validate_config
+from shockcal.config import validate_or_exit
 
 
 configfile: "config/config.yaml"
 
 
 # snakemake's `validate` against workflow/schemas/config.schema.yaml (defaults filled in), then the
-# cross-field rules; errors name the key path: "config: simulate.chunk_size: 0 is less than ..."
-validate_config(config, source="config")
+# cross-field rules and the design file's contents; a bad config ends snakemake with its message
+# alone, naming the key path: "shockcal: error: config: simulate.chunk_size: 0 is less than ..."
+validate_or_exit(config, source="config")
 
 RESULTS = config["study"]["results_dir"]
 SHOTS = list(config["shots"])

@@ -25,6 +25,7 @@ import pandas as pd
 from shockcal.diagnostics import RHAT_LIMIT, ess_bulk, ess_tail, split_rhat
 from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
+from shockcal.plausibility import check_observed_table
 from shockcal.sampler import run_ensemble
 
 log = logging.getLogger("shockcal.calibration")
@@ -140,6 +141,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str
     """
     settings = {**config["calibration"], **overrides}
     problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"], source)
+    check_observed_table(observed, shots, source, config["checks"]["observed_units"])
     n_samples = settings.get("n_samples") or settings["n_samples_single" if len(shots) == 1 else "n_samples_joint"]
     seed = settings.get("seed", config["study"]["seed"] + settings["seed_offset"])
     samples, info = sample(problem, n_samples, settings, seed)

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import yaml
 
-from shockcal.errors import ConfigError
+from shockcal.errors import ConfigError, InputError, ShockcalError
+from shockcal.plausibility import check_observed
 
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
@@ -49,6 +50,15 @@ def validate_config(config: dict, source: str = "config") -> dict:
     return config
 
 
+def validate_or_exit(config: dict, source: str = "config") -> dict:
+    """`validate_config` for the Snakefile: a bad config or design ends snakemake with the message alone
+    (SystemExit), where an exception would print a traceback around it."""
+    try:
+        return validate_config(config, source)
+    except ShockcalError as exc:
+        raise SystemExit(f"shockcal: error: {exc}") from None
+
+
 def _normalise_shot_names(config: dict) -> None:
     """YAML reads an unquoted shot name like 104 as an int; shot names are strings."""
     for section in (config.get("shots"), (config.get("observed") or {}).get("features"),
@@ -70,7 +80,8 @@ def _schema_message(exc: Exception) -> str:
 
 
 def check_semantics(config: dict, source: str = "config") -> None:
-    """Rules beyond the schema: box bounds ordered, shot mappings name real inputs, files exist."""
+    """Rules beyond the schema: box bounds ordered, shot mappings name real inputs, files exist, the design
+    file's contents pass `load_design`, observed features look like m/s and us (shockcal.plausibility)."""
     inputs = config["inputs"]
     for name, box in inputs.items():
         if not box["min"] < box["max"]:
@@ -94,9 +105,18 @@ def check_semantics(config: dict, source: str = "config") -> None:
         for shot in observed[section]:
             if shot not in config["shots"]:
                 raise ConfigError(f"{source}: observed.{section}.{shot}: unknown shot; known shots are {sorted(config['shots'])}")
+    for shot, features in observed["features"].items():
+        check_observed(features, f"{source}: observed.features.{shot}", config["checks"]["observed_units"], ConfigError)
     for shot, record in observed["records"].items():
         if not Path(record["path"]).is_file():
             raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
+    if design_file:
+        from shockcal.design import load_design  # shockcal.design imports this module
+
+        try:
+            load_design(design_file, config)
+        except InputError as exc:
+            raise ConfigError(f"{source}: design.file: {exc}") from None
 
 
 def shot_config(config: dict, shot: str) -> dict:

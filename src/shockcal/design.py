@@ -8,6 +8,7 @@ every shot: `shot_parameters` maps a row onto one shot (SPEC section 3).
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +18,9 @@ import pandas as pd
 from shockcal.config import STRENGTH_INPUTS, input_bounds, input_names, shot_config
 from shockcal.errors import InputError
 from shockcal.io import read_table, require_columns
+from shockcal.plausibility import range_problem
+
+log = logging.getLogger("shockcal.design")
 
 
 def latin_hypercube(config: dict, n_runs: int, seed: int) -> pd.DataFrame:
@@ -35,8 +39,9 @@ def load_design(path: str | Path, config: dict, columns: list[str] | None = None
     """Read a CSV/Parquet design, check it, and return it with an integer `run` column.
 
     `columns` are the inputs that must be present (default: all config inputs). Values must be
-    finite; Johnson-Cook inputs non-negative; velocities and shear moduli positive (checked per
-    shot by `shot_parameters`). Errors name the file, the row and the parameter.
+    finite; Johnson-Cook inputs non-negative; inside the prior box (`check_design_box`); velocities
+    and shear moduli positive (checked per shot by `validate_shot_parameters`). Errors name the
+    file, the row and the parameter.
     """
     design = read_table(path)
     columns = input_names(config) if columns is None else columns
@@ -57,7 +62,28 @@ def load_design(path: str | Path, config: dict, columns: list[str] | None = None
             row = design.loc[values < 0, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
     design["run"] = design["run"].astype(np.int64)
+    check_design_box(design, config, columns, path)
     return design.reset_index(drop=True)
+
+
+def check_design_box(design: pd.DataFrame, config: dict, columns: list[str], source) -> None:
+    """Stop at the first run with an input outside the prior box (config `inputs`), saying which unit
+    the value would fit (e.g. V1 = 204: m/s, not cm/us); with `checks.design_box: false`, warn instead."""
+    velocities = {spec["velocity_input"]: shot for shot, spec in config["shots"].items()}
+    for name in columns:
+        box = config["inputs"][name]
+        values = design[name].to_numpy(dtype=float)
+        slack = 1e-9 * (box["max"] - box["min"])  # float noise of a table written at a bound
+        outside = (values < box["min"] - slack) | (values > box["max"] + slack)
+        if not outside.any():
+            continue
+        first = int(np.argmax(outside))
+        what = f"impact velocity {name} of shot {velocities[name]}" if name in velocities else f"parameter {name}"
+        problem = range_problem(what, values[first], box["unit"], (box["min"], box["max"]), f"the prior box inputs.{name}")
+        message = f"{source}: run {design['run'].iloc[first]}: {problem}; {int(outside.sum())} of {len(values)} runs are outside on {name}"
+        if config["checks"]["design_box"]:
+            raise InputError(f"{message}. If these points are intended, set checks.design_box: false")
+        log.warning("%s (accepted: checks.design_box: false)", message)
 
 
 @dataclass(frozen=True)

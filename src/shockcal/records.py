@@ -4,11 +4,15 @@
 which names the columns, e.g. "% Up (m/s)  t (us)" or "% time (us)  Up (m/s)": the order differs
 between files) and general CSV or whitespace tables whose time and velocity columns the user names.
 The record is returned as released: noise, baseline offset and pre-trigger content are handled by
-the feature extractor (shockcal.features), not here.
+the feature extractor (shockcal.features), not here. A record whose peak velocity, duration or time
+step is implausible for a plate-impact VISAR record in m/s and microseconds (shockcal.plausibility:
+km/s, ns, ...) is an error unless the environment sets SHOCKCAL_ALLOW_IMPLAUSIBLE_RECORDS=1.
 """
 
 from __future__ import annotations
 
+import logging
+import os
 import re
 from pathlib import Path
 
@@ -16,10 +20,14 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
+from shockcal.plausibility import PEAK_VELOCITY_M_S, RECORD_DURATION_US, TIME_STEP_US, range_problem
 
+log = logging.getLogger("shockcal.records")
 MIN_POINTS = 50
+OPT_OUT = "SHOCKCAL_ALLOW_IMPLAUSIBLE_RECORDS"
 _TIME_NAMES = re.compile(r"^(t|time|t_us)\b", re.IGNORECASE)
 _VELOCITY_NAMES = re.compile(r"^(up|u|v|vel|velocity|ufs|u_fs|v_m_s)\b", re.IGNORECASE)
+_DECIMAL_COMMA = re.compile(r"^[-+]?\d*,\d+([eE][-+]?\d+)?$")
 
 
 def read_record(path, time_column=None, velocity_column=None) -> tuple[np.ndarray, np.ndarray]:
@@ -33,6 +41,7 @@ def read_record(path, time_column=None, velocity_column=None) -> tuple[np.ndarra
     t = pd.to_numeric(table[t_col], errors="coerce").to_numpy(dtype=float)
     v = pd.to_numeric(table[v_col], errors="coerce").to_numpy(dtype=float)
     check_record(t, v, path)
+    check_plausible(t, v, path)
     return t, v
 
 
@@ -48,18 +57,54 @@ def check_record(t: np.ndarray, v: np.ndarray, source) -> None:
         raise InputError(f"record {source}: time is not increasing at row {int(np.argmax(steps <= 0)) + 1}")
 
 
+def check_plausible(t: np.ndarray, v: np.ndarray, source) -> None:
+    """Peak velocity (of a record that varies), duration and median time step in the plausible ranges of
+    shockcal.plausibility, else an error saying which unit would fit (a warning under OPT_OUT=1)."""
+    problems = [
+        range_problem("peak velocity", float(np.max(v)), "m/s", PEAK_VELOCITY_M_S) if np.ptp(v) > 0 else None,
+        range_problem("duration", float(t[-1] - t[0]), "us", RECORD_DURATION_US),
+        range_problem("median time step", float(np.median(np.diff(t))), "us", TIME_STEP_US),
+    ]
+    problems = [p for p in problems if p]
+    if not problems:
+        return
+    message = f"record {source}: {'; '.join(problems)}"
+    if os.environ.get(OPT_OUT) != "1":
+        raise InputError(f"{message}. Records are read as time in us and velocity in m/s; "
+                         f"if the record is right as it is, set {OPT_OUT}=1 in the environment")
+    log.warning("%s (accepted: %s=1)", message, OPT_OUT)
+
+
 def _read_table(path: Path) -> pd.DataFrame:
-    """A table with named columns: from a '%' header line, or a CSV/whitespace header."""
-    lines = path.read_text(errors="replace").splitlines()
+    """A table with named columns: from a '%' header line, or a header line; fields separated by
+    whitespace (tabs), ';' or ','. A binary file, rows of unequal width or decimal commas are errors
+    naming the file and the line."""
+    raw = path.read_bytes()
+    if b"\0" in raw:
+        raise InputError(f"record {path}: a binary file, not a text table of time and velocity columns")
+    lines = raw.decode(errors="replace").splitlines()
     comments = [line.lstrip("%").strip() for line in lines if line.startswith("%")]
-    body = [line for line in lines if line.strip() and not line.startswith("%")]
-    if not body:
+    numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip() and not line.startswith("%")]
+    if not numbered:
         raise InputError(f"record {path}: no data lines")
-    sep = "," if "," in body[0] else r"\s+"
-    first = re.split(sep, body[0].strip())
-    has_header = not all(_is_number(x) for x in first)
-    data = pd.read_csv(pd.io.common.StringIO("\n".join(body)), sep=sep, header=0 if has_header else None,
-                       engine="python")
+    first = numbered[0][1]
+    sep = next((c for c in ";," if c in first and "\t" not in first), None)
+    fields = [line.split(sep) for _, line in numbered]
+    odd = next((k for k, row in enumerate(fields) if len(row) != len(fields[0])), None)
+    if odd is not None:
+        raise InputError(f"record {path}: line {numbered[odd][0]} has {len(fields[odd])} fields, "
+                         f"line {numbered[0][0]} has {len(fields[0])}")
+    comma_decimal = next((x for x in fields[-1] if _DECIMAL_COMMA.match(x.strip())), None)
+    if comma_decimal:
+        raise InputError(f"record {path}: line {numbered[-1][0]}: {comma_decimal.strip()!r} has a decimal comma; "
+                         f"write numbers with a decimal point")
+    body = [line for _, line in numbered]
+    has_header = not all(_is_number(x.strip()) for x in fields[0])
+    try:
+        data = pd.read_csv(pd.io.common.StringIO("\n".join(body)), sep=sep or r"\s+", header=0 if has_header else None,
+                           engine="python")
+    except (pd.errors.ParserError, ValueError) as exc:
+        raise InputError(f"record {path}: not a readable table: {str(exc).splitlines()[0]}") from None
     if not has_header and comments:
         names = [n.strip() for n in re.split(r"\s{2,}|\t", comments[-1]) if n.strip()]
         if len(names) == data.shape[1]:
