@@ -128,7 +128,12 @@ def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
     assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
                  "--features", f"104S={tmp_path / 'f.parquet'}", "--out", str(tmp_path / "emu")]) == 0
     cv = pd.read_parquet(tmp_path / "emu" / "cv.parquet")
-    assert set(cv.columns) == {"run", "shot", "feature", "simulated", "predicted", "predicted_sd"}
-    assert len(cv) == 30 * 4
+    assert set(cv.columns) == {"run", "shot", "feature", "simulated", "predicted", "predicted_sd", "scheme"}
+    assert len(cv) == 30 * 4 and set(cv["scheme"]) == {"loo_closed_form"}
+    held = pd.read_parquet(tmp_path / "emu" / "cv_heldout.parquet")
+    assert (held["scheme"] == "kfold").sum() == 30 * 4 and set(held["scheme"]) == {"kfold", "outer"}
+    rmse = pd.read_csv(tmp_path / "emu" / "cv_rmse.csv")
+    assert list(rmse.loc[rmse["shot"] == "all", "scheme"]) == ["loo_closed_form", "kfold", "outer"]
+    assert main(["emulate-cv", "--emulator", str(tmp_path / "emu")]) == 0
     assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
                  "--features", "104S", "--out", str(tmp_path / "x")]) == 2

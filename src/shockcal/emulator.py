@@ -20,17 +20,19 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from joblib import Parallel, delayed
+from threadpoolctl import threadpool_limits
 
 from shockcal.config import STRENGTH_INPUTS, shot_config
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 log = logging.getLogger("shockcal.emulator")
 
@@ -47,10 +49,13 @@ class InputMap:
     def design_inputs(self) -> list[str]:
         return list(dict.fromkeys(t for terms in self.terms for t in terms))
 
+    def raw(self, inputs) -> np.ndarray:
+        """(N, d) inputs (sums of design columns) from a mapping or DataFrame of design columns."""
+        return np.column_stack([sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms])
+
     def scaled(self, inputs) -> np.ndarray:
-        """(N, d) inputs scaled to [0, 1] from a mapping or DataFrame of design columns."""
-        raw = np.column_stack([sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms])
-        return (raw - self.lower) / (self.upper - self.lower)
+        """(N, d) inputs scaled to [0, 1] by the box."""
+        return (self.raw(inputs) - self.lower) / (self.upper - self.lower)
 
     def to_json(self) -> dict:
         return {"names": self.names, "terms": self.terms, "lower": self.lower.tolist(), "upper": self.upper.tolist()}
@@ -85,47 +90,110 @@ def _box_map(config, names, terms) -> InputMap:
     return InputMap(names, terms, lower, upper)
 
 
-class PCEmulator:
-    """GP emulator of a block of features (one shot's, or all shots') on a principal-component basis."""
+@dataclass
+class Settings:
+    """How a PCGPEmulator is fitted (config `emulator`, or keyword arguments from a notebook)."""
 
-    def __init__(self, input_map: InputMap, shots: list[str], mean, scale, basis, residual_cov,
-                 x_train, y_train, runs, hypers: list[Hyper]):
-        self.input_map, self.shots = input_map, shots
+    family: str = "matern52"       # correlation family (gp.KERNELS)
+    fit_mean: bool = True          # per-component constant mean (GLS), else zero
+    n_components: float = 0.999    # integer count, or variance fraction in (0, 1)
+    n_starts: int = 2              # L-BFGS-B starts per GP
+    max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
+    seed: int = 0
+    n_jobs: int = 1                # processes for the GP fits (one BLAS thread each)
+
+    @classmethod
+    def from_config(cls, settings: dict, seed: int) -> "Settings":
+        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs")
+        return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
+
+
+@dataclass
+class HeldOut:
+    """Held-out predictions of a cross-validation scheme: row indices, mean and sd (N, F)."""
+
+    scheme: str
+    rows: np.ndarray
+    mean: np.ndarray
+    sd: np.ndarray
+
+
+def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int) -> Hyper:
+    with threadpool_limits(1):
+        return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
+                                   family=settings.family, fit_mean=settings.fit_mean).hyper
+
+
+class PCGPEmulator:
+    """Principal-component GP emulator on plain arrays: inputs X (N, d) in a box, outputs Y (N, F).
+
+    >>> emu = PCGPEmulator.fit(X, Y, lower, upper, Settings(family="matern52"))
+    >>> mean, cov = emu.predict(X_new)            # (M, F), (M, F, F)
+    >>> cv = emu.cross_validate(10)               # refits everything per fold
+    """
+
+    def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
+                 settings: Settings):
+        self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
         self.residual_cov = np.asarray(residual_cov)
-        self.x_train, self.y_train, self.runs = np.asarray(x_train), np.asarray(y_train), np.asarray(runs)
+        self.x_train, self.y_train = np.asarray(x_train, dtype=float), np.asarray(y_train, dtype=float)
+        self.settings = settings
         self.weights = self.project((self.y_train - self.mean) / self.scale)
-        self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h) for j, h in enumerate(hypers)]
+        self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h, family=settings.family)
+                    for j, h in enumerate(hypers)]
 
     def project(self, z: np.ndarray) -> np.ndarray:
         """Basis weights of standardized outputs z (least squares on the orthogonal basis)."""
         return z @ self.basis.T / np.sum(self.basis**2, axis=1)
 
+    def scaled(self, X) -> np.ndarray:
+        return (np.asarray(X, dtype=float) - self.lower) / (self.upper - self.lower)
+
     @classmethod
-    def fit(cls, input_map: InputMap, shots: list[str], x_design: pd.DataFrame, y: np.ndarray, runs,
-            n_components: float, n_starts: int, seed: int, max_fit_runs: int) -> "PCEmulator":
-        """Standardize y (N, F), build the basis, fit one GP per weight at its MAP."""
-        x = input_map.scaled(x_design)
-        mean, scale = y.mean(0), y.std(0)
-        scale = np.where(scale > 0, scale, 1.0)
-        z = (y - mean) / scale
-        u, s, vt = np.linalg.svd(z, full_matrices=False)
-        p = _component_count(s, n_components)
-        n = len(y)
-        weights = u[:, :p] * np.sqrt(n)                   # unit-variance weights
-        basis = vt[:p] * (s[:p, None] / np.sqrt(n))       # z ~ weights @ basis
-        residual = z - weights @ basis
-        residual_cov = residual.T @ residual / n
-        rng = np.random.default_rng(seed)
-        fit_rows = None if n <= max_fit_runs else np.sort(rng.choice(n, max_fit_runs, replace=False))
-        hypers = [GaussianProcess.fit(x, weights[:, j], n_starts=n_starts, seed=seed + j, fit_rows=fit_rows).hyper
-                  for j in range(p)]
-        log.info("emulator %s: %d runs, %d inputs, %d of %d components (%.4f of variance)",
-                 "+".join(shots), n, x.shape[1], p, len(s), (s[:p] ** 2).sum() / (s**2).sum())
-        return cls(input_map, shots, mean, scale, basis, residual_cov, x, y, runs, hypers)
+    def fit(cls, X, Y, lower, upper, settings: Settings | None = None) -> "PCGPEmulator":
+        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode."""
+        return cls._fit_many(X, Y, lower, upper, settings or Settings(), [np.arange(len(Y))])[0]
+
+    @classmethod
+    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets) -> list["PCGPEmulator"]:
+        """One emulator per set of training rows, all GP fits in one (parallel) batch."""
+        X, Y = np.asarray(X, dtype=float), np.asarray(Y, dtype=float)
+        x_all = (X - np.asarray(lower, dtype=float)) / (np.asarray(upper, dtype=float) - np.asarray(lower, dtype=float))
+        parts, tasks = [], []
+        for rows in row_sets:
+            x, y = x_all[rows], Y[rows]
+            mean, scale = y.mean(0), y.std(0)
+            scale = np.where(scale > 0, scale, 1.0)
+            z = (y - mean) / scale
+            u, s, vt = np.linalg.svd(z, full_matrices=False)
+            p = _component_count(s, settings.n_components)
+            n = len(y)
+            weights = u[:, :p] * np.sqrt(n)                   # unit-variance weights
+            basis = vt[:p] * (s[:p, None] / np.sqrt(n))       # z ~ weights @ basis
+            residual = z - weights @ basis
+            rng = np.random.default_rng(settings.seed)
+            fit_rows = None if n <= settings.max_fit_runs else np.sort(rng.choice(n, settings.max_fit_runs, replace=False))
+            parts.append((x, y, mean, scale, basis, residual.T @ residual / n))
+            tasks += [(x, weights[:, j], fit_rows, settings, settings.seed + j) for j in range(p)]
+        if settings.n_jobs > 1:
+            hypers = Parallel(n_jobs=settings.n_jobs)(delayed(_fit_hyper)(*t) for t in tasks)
+        else:
+            hypers = [_fit_hyper(*t) for t in tasks]
+        out, start = [], 0
+        for x, y, mean, scale, basis, residual_cov in parts:
+            p = len(basis)
+            out.append(cls(lower, upper, mean, scale, basis, residual_cov, x, y, hypers[start:start + p],
+                           settings))
+            start += p
+        return out
+
+    def predict(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """Mean (N, F) and covariance (N, F, F) at inputs X (N, d) in the box's units."""
+        return self.predict_scaled(self.scaled(X))
 
     def predict_scaled(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (N, F) and covariance (N, F, F) in m/s at scaled inputs x (N, d)."""
+        """Mean (N, F) and covariance (N, F, F) at inputs x scaled to [0, 1]."""
         w_mean = np.empty((len(x), len(self.gps)))
         w_var = np.empty_like(w_mean)
         for j, gp in enumerate(self.gps):
@@ -134,30 +202,78 @@ class PCEmulator:
         mean = self.mean + (w_mean @ self.basis) * self.scale
         return mean, z_cov * np.outer(self.scale, self.scale)
 
-    def loo(self) -> tuple[np.ndarray, np.ndarray]:
-        """Closed-form leave-one-out mean (N, F) and sd (N, F) in m/s, hyperparameters and basis fixed."""
+    def loo(self) -> HeldOut:
+        """Closed-form leave-one-out (hyperparameters and basis fixed): a fast diagnostic that flatters."""
         w_mean = np.empty_like(self.weights)
         w_var = np.empty_like(self.weights)
         for j, gp in enumerate(self.gps):
             w_mean[:, j], w_var[:, j] = gp.loo()
         z_var = w_var @ self.basis**2 + np.diag(self.residual_cov)
-        return self.mean + (w_mean @ self.basis) * self.scale, np.sqrt(z_var) * self.scale
+        return HeldOut("loo_closed_form", np.arange(len(self.y_train)),
+                       self.mean + (w_mean @ self.basis) * self.scale, np.sqrt(z_var) * self.scale)
 
-    def to_arrays(self, prefix: str) -> dict:
-        arrays = {"mean": self.mean, "scale": self.scale, "basis": self.basis, "residual_cov": self.residual_cov,
-                  "x_train": self.x_train, "y_train": self.y_train, "runs": self.runs}
-        return {f"{prefix}/{k}": v for k, v in arrays.items()}
+    def cross_validate(self, k: int = 10, seed: int | None = None) -> HeldOut:
+        """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold."""
+        n = len(self.y_train)
+        order = np.random.default_rng(self.settings.seed if seed is None else seed).permutation(n)
+        folds = [np.sort(f) for f in np.array_split(order, min(k, n))]
+        trains = [np.setdiff1d(np.arange(n), f) for f in folds]
+        return self._held_out("kfold", folds, trains)
+
+    def outer_check(self, margin: float = 0.05) -> HeldOut:
+        """Train on runs with every scaled input in [margin, 1 - margin]; predict the others (near faces)."""
+        inner = np.all((self.x_train >= margin) & (self.x_train <= 1 - margin), axis=1)
+        if inner.sum() < self.x_train.shape[1] + 2:
+            log.warning("outer check skipped: %d runs inside the inner box, %d needed", inner.sum(),
+                        self.x_train.shape[1] + 2)
+            empty = np.empty((0, self.y_train.shape[1]))
+            return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
+        return self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
+
+    def _held_out(self, scheme, tests, trains) -> HeldOut:
+        models = self._fit_many(self.x_train, self.y_train, np.zeros(len(self.lower)), np.ones(len(self.upper)),
+                                self.settings, trains)
+        rows = np.concatenate(tests)
+        mean, sd = np.empty((len(rows), self.y_train.shape[1])), np.empty((len(rows), self.y_train.shape[1]))
+        start = 0
+        for model, test in zip(models, tests):
+            m, c = model.predict_scaled(self.x_train[test])
+            mean[start:start + len(test)], sd[start:start + len(test)] = m, np.sqrt(np.einsum("nff->nf", c))
+            start += len(test)
+        return HeldOut(scheme, rows, mean, sd)
+
+    def to_arrays(self, prefix: str = "") -> dict:
+        arrays = {"lower": self.lower, "upper": self.upper, "mean": self.mean, "scale": self.scale,
+                  "basis": self.basis, "residual_cov": self.residual_cov, "x_train": self.x_train,
+                  "y_train": self.y_train}
+        return {f"{prefix}{k}": v for k, v in arrays.items()}
 
     def to_json(self) -> dict:
-        return {"shots": self.shots, "inputs": self.input_map.to_json(),
+        return {"settings": asdict(self.settings),
                 "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
-                                     "lambda_n": g.hyper.lambda_n} for g in self.gps]}
+                                     "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
 
     @classmethod
-    def from_saved(cls, meta: dict, arrays, prefix: str) -> "PCEmulator":
-        hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"]) for h in meta["hyperparameters"]]
-        fields = ("mean", "scale", "basis", "residual_cov", "x_train", "y_train", "runs")
-        return cls(InputMap.from_json(meta["inputs"]), meta["shots"], *(arrays[f"{prefix}/{k}"] for k in fields), hypers)
+    def from_saved(cls, meta: dict, arrays, prefix: str = "") -> "PCGPEmulator":
+        hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
+        fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
+        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]))
+
+    def save(self, path) -> Path:
+        """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
+        path = Path(path)
+        header = {"format": "shockcal-pcgp", "version": FORMAT_VERSION, **self.to_json()}
+        np.savez(path, header=np.array(json.dumps(header)), **self.to_arrays())
+        return path
+
+    @classmethod
+    def load(cls, path) -> "PCGPEmulator":
+        with np.load(path) as npz:
+            arrays = dict(npz)
+        header = json.loads(str(arrays.pop("header")))
+        if header.get("format") != "shockcal-pcgp" or header.get("version") != FORMAT_VERSION:
+            raise InputError(f"{path}: not a shockcal PC-GP emulator of version {FORMAT_VERSION}")
+        return cls.from_saved(header, arrays)
 
 
 def _component_count(singular_values: np.ndarray, n_components: float) -> int:
@@ -168,12 +284,22 @@ def _component_count(singular_values: np.ndarray, n_components: float) -> int:
     return int(np.searchsorted(explained, n_components) + 1)
 
 
+@dataclass
+class Block:
+    """One PC-GP emulator of some shots' features over design inputs combined by an input map."""
+
+    input_map: InputMap
+    shots: list[str]
+    runs: np.ndarray
+    model: PCGPEmulator
+
+
 class Emulator:
-    """The study's emulator: one PCEmulator per shot (per_shot) or one for all shots (joint)."""
+    """The study's emulator: one block per shot (per_shot) or one for all shots (joint)."""
 
     feature_names = CALIBRATION_FEATURES
 
-    def __init__(self, structure: str, blocks: list[PCEmulator], bounds: dict, shot_inputs: dict):
+    def __init__(self, structure: str, blocks: list[Block], bounds: dict, shot_inputs: dict):
         self.structure = structure
         self.blocks = blocks
         self.shots = [s for b in blocks for s in b.shots]
@@ -205,14 +331,14 @@ class Emulator:
             wanted = [s for s in shots if s in block.shots]
             if not wanted:
                 continue
-            m, c = block.predict_scaled(block.input_map.scaled(self._complete(inputs, block, n)))
+            m, c = block.model.predict(block.input_map.raw(self._complete(inputs, block, n)))
             src = np.concatenate([np.arange(k) + k * block.shots.index(s) for s in wanted])
             dst = np.concatenate([np.arange(k) + k * shots.index(s) for s in wanted])
             mean[:, dst] = m[:, src]
             cov[:, dst[:, None], dst[None, :]] = c[:, src[:, None], src[None, :]]
         return mean, cov
 
-    def _complete(self, inputs, block: PCEmulator, n: int) -> dict:
+    def _complete(self, inputs, block: Block, n: int) -> dict:
         """The block's design inputs, those not given held at mid-box."""
         return {t: np.asarray(inputs[t], dtype=float) if t in inputs else np.full(n, np.mean(self._bounds[t]))
                 for t in block.input_map.design_inputs()}
@@ -222,32 +348,40 @@ class Emulator:
         if missing:
             raise InputError(f"the emulator has no shot {missing}; it was fitted for {self.shots}")
 
-    def cv_table(self) -> pd.DataFrame:
-        """Leave-one-out table: run, shot, feature, simulated, predicted, predicted_sd (m/s)."""
+    def cv_table(self, scheme: str = "loo_closed_form", folds: int = 10, margin: float = 0.05) -> pd.DataFrame:
+        """Held-out table (run, shot, feature, simulated, predicted, predicted_sd in m/s, scheme).
+
+        Schemes: `loo_closed_form` (fast diagnostic, hyperparameters fixed), `kfold` (everything
+        refitted per fold) and `outer` (trained on the inner box [margin, 1 - margin], predicting the rest).
+        """
         k = len(self.feature_names)
         parts = []
         for block in self.blocks:
-            loo_mean, loo_sd = block.loo()
+            held = {"loo_closed_form": block.model.loo, "kfold": lambda: block.model.cross_validate(folds),
+                    "outer": lambda: block.model.outer_check(margin)}[scheme]()
             for i, shot in enumerate(block.shots):
                 for f, feature in enumerate(self.feature_names):
                     col = k * i + f
-                    parts.append(pd.DataFrame({"run": block.runs, "shot": shot, "feature": feature,
-                                               "simulated": block.y_train[:, col], "predicted": loo_mean[:, col],
-                                               "predicted_sd": loo_sd[:, col]}))
+                    parts.append(pd.DataFrame({"run": block.runs[held.rows], "shot": shot, "feature": feature,
+                                               "simulated": block.model.y_train[held.rows, col],
+                                               "predicted": held.mean[:, col], "predicted_sd": held.sd[:, col],
+                                               "scheme": scheme}))
         return pd.concat(parts, ignore_index=True)
 
     def save(self, directory) -> Path:
-        """Write emulator.npz (arrays) and emulator.json (version, names, hyperparameters)."""
+        """Write emulator.npz (arrays) and emulator.json (version, names, settings, hyperparameters)."""
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
         arrays = {}
         for i, block in enumerate(self.blocks):
-            arrays.update(block.to_arrays(f"block{i}"))
+            arrays.update(block.model.to_arrays(f"block{i}/"))
+            arrays[f"block{i}/runs"] = block.runs
         np.savez(directory / "emulator.npz", **arrays)
         meta = {"format": "shockcal-emulator", "version": FORMAT_VERSION, "structure": self.structure,
                 "feature_names": self.feature_names, "feature_units": "m/s",
-                "input_bounds": {k: list(v) for k, v in self._bounds.items()},
-                "shot_inputs": self._shot_inputs, "blocks": [b.to_json() for b in self.blocks]}
+                "input_bounds": {k: list(v) for k, v in self._bounds.items()}, "shot_inputs": self._shot_inputs,
+                "blocks": [{"shots": b.shots, "inputs": b.input_map.to_json(), **b.model.to_json()}
+                           for b in self.blocks]}
         (directory / "emulator.json").write_text(json.dumps(meta, indent=1))
         return directory
 
@@ -264,7 +398,8 @@ class Emulator:
                              f"this shockcal reads version {FORMAT_VERSION}: refit it with `shockcal emulate`")
         with np.load(directory / "emulator.npz") as npz:
             arrays = dict(npz)
-        blocks = [PCEmulator.from_saved(b, arrays, f"block{i}") for i, b in enumerate(meta["blocks"])]
+        blocks = [Block(InputMap.from_json(b["inputs"]), b["shots"], arrays[f"block{i}/runs"],
+                        PCGPEmulator.from_saved(b, arrays, f"block{i}/")) for i, b in enumerate(meta["blocks"])]
         return cls(meta["structure"], blocks, {k: tuple(v) for k, v in meta["input_bounds"].items()},
                    meta["shot_inputs"])
 
@@ -306,41 +441,43 @@ def _check_training_inputs(table: pd.DataFrame, input_map: InputMap, label: str)
 def fit_emulator(config: dict, design: pd.DataFrame, features: dict[str, pd.DataFrame],
                  sources: dict[str, str] | None = None) -> Emulator:
     """Fit the configured emulator structure to design + per-shot feature tables."""
-    settings = config["emulator"]
     shots = list(features)
     sources = sources or {shot: f"features of {shot}" for shot in shots}
     tables = {shot: training_data(design, features[shot], shot, sources[shot]) for shot in shots}
-    common = dict(n_components=settings["n_components"], n_starts=settings["n_starts"],
-                  max_fit_runs=settings["max_fit_runs"])
-    seed = config["study"]["seed"]
-    if settings["structure"] == "per_shot":
-        blocks = []
-        for i, shot in enumerate(shots):
-            input_map = shot_input_map(config, shot)
-            _check_training_inputs(tables[shot], input_map, sources[shot])
-            blocks.append(PCEmulator.fit(input_map, [shot], tables[shot], tables[shot][CALIBRATION_FEATURES].to_numpy(),
-                                         tables[shot]["run"].to_numpy(), seed=seed + 100 * i, **common))
+    structure = config["emulator"]["structure"]
+    if structure == "per_shot":
+        groups = [([shot], shot_input_map(config, shot), tables[shot], sources[shot], CALIBRATION_FEATURES)
+                  for shot in shots]
     else:
         joined = tables[shots[0]].rename(columns={f: f"{shots[0]}:{f}" for f in CALIBRATION_FEATURES})
         for shot in shots[1:]:
             joined = joined.merge(tables[shot][["run", *CALIBRATION_FEATURES]].rename(
                 columns={f: f"{shot}:{f}" for f in CALIBRATION_FEATURES}), on="run", how="inner")
-        input_map = joint_input_map(config, shots)
-        _check_training_inputs(joined, input_map, "joint training set")
-        y = joined[[f"{s}:{f}" for s in shots for f in CALIBRATION_FEATURES]].to_numpy()
-        blocks = [PCEmulator.fit(input_map, shots, joined, y, joined["run"].to_numpy(), seed=seed, **common)]
+        groups = [(shots, joint_input_map(config, shots), joined, "joint training set",
+                   [f"{s}:{f}" for s in shots for f in CALIBRATION_FEATURES])]
+    blocks = []
+    for i, (block_shots, input_map, table, label, columns) in enumerate(groups):
+        _check_training_inputs(table, input_map, label)
+        settings = Settings.from_config(config["emulator"], config["study"]["seed"] + 100 * i)
+        model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
+                                 settings)
+        log.info("emulator %s: %d runs, %d inputs, %d of %d components, %s correlation", "+".join(block_shots),
+                 len(table), len(input_map.names), len(model.gps), len(columns), settings.family)
+        blocks.append(Block(input_map, block_shots, table["run"].to_numpy(), model))
     bounds = {k: (v["min"], v["max"]) for k, v in config["inputs"].items()}
-    return Emulator(settings["structure"], blocks, bounds, {s: _shot_terms(config, s) for s in shots})
+    return Emulator(structure, blocks, bounds, {s: _shot_terms(config, s) for s in shots})
 
 
 def rmse_table(cv: pd.DataFrame) -> pd.DataFrame:
-    """Per shot and feature: LOO RMSE, bias (m/s) and 90%-band coverage, plus an overall row."""
+    """Per scheme, shot and feature: RMSE, bias (m/s) and 90%-band coverage, plus an overall row per scheme."""
     err = cv["predicted"] - cv["simulated"]
     inside = (err.abs() <= 1.6449 * cv["predicted_sd"])
     frame = cv.assign(sq=err**2, err=err, inside=inside)
-    per = frame.groupby(["shot", "feature"], sort=False).agg(rmse_m_s=("sq", "mean"), bias_m_s=("err", "mean"),
-                                                              coverage90=("inside", "mean")).reset_index()
-    per["rmse_m_s"] = np.sqrt(per["rmse_m_s"])
-    overall = pd.DataFrame([{"shot": "all", "feature": "all", "rmse_m_s": float(np.sqrt(frame["sq"].mean())),
-                             "bias_m_s": float(err.mean()), "coverage90": float(inside.mean())}])
-    return pd.concat([per, overall], ignore_index=True).round(3)
+    aggregates = dict(rmse_m_s=("sq", "mean"), bias_m_s=("err", "mean"), coverage90=("inside", "mean"))
+    per = frame.groupby(["scheme", "shot", "feature"], sort=False).agg(**aggregates).reset_index()
+    overall = frame.groupby("scheme", sort=False).agg(**aggregates).reset_index().assign(shot="all", feature="all")
+    table = pd.concat([per, overall], ignore_index=True)
+    table["rmse_m_s"] = np.sqrt(table["rmse_m_s"])
+    order = {s: i for i, s in enumerate(dict.fromkeys(cv["scheme"]))}
+    table = table.sort_values("scheme", key=lambda c: c.map(order), kind="stable")
+    return table[["scheme", "shot", "feature", "rmse_m_s", "bias_m_s", "coverage90"]].round(3).reset_index(drop=True)

@@ -1,12 +1,14 @@
-"""One Gaussian process with the correlation of Higdon et al. (2008), fitted at its posterior mode.
+"""One Gaussian process over inputs in [0, 1]^d, hyperparameters at their posterior mode.
 
-    cov(w(t), w(t')) = prod_k rho_k^(4 (t_k - t'_k)^2) / lambda_w  +  delta(t, t') / lambda_n
+    cov(w(t), w(t')) = c(r^2) / lambda_w  +  delta(t, t') / lambda_n,   r^2 = sum_k beta_k (t_k - t'_k)^2
 
-with inputs t in [0, 1]^d. We write rho_k = exp(-beta_k / 4), so the correlation is
-exp(-sum_k beta_k (t_k - t'_k)^2). Priors (SPEC section 5): lambda_w ~ Gamma(5, 5),
-rho_k ~ Beta(1, 0.1); the nugget precision lambda_n ~ Gamma(3, 0.003) as in GPM/SA. The mode is
-found in the coordinates (log lambda_w, log beta_k, log lambda_n), Jacobian included, where the
-posterior is proper and smooth (the Beta(1, 0.1) density itself is unbounded at rho = 1).
+with a constant mean (estimated by generalised least squares, or fixed at 0). Correlation families
+c (`KERNELS`): `gaussian` exp(-r^2), Higdon et al.'s prod_k rho_k^(4 (t_k - t'_k)^2) with
+rho_k = exp(-beta_k / 4); `matern52` and `matern32`, the Matern functions of r. Priors (SPEC
+section 5): lambda_w ~ Gamma(5, 5), rho_k = exp(-beta_k / 4) ~ Beta(1, 0.1) for every family, nugget
+precision lambda_n ~ Gamma(3, 0.003) as in GPM/SA. The mode is found in the coordinates
+(log lambda_w, log beta_k, log lambda_n), Jacobian included, where the posterior is proper and
+smooth (the Beta(1, 0.1) density itself is unbounded at rho = 1).
 """
 
 from __future__ import annotations
@@ -20,34 +22,51 @@ LAMBDA_W_PRIOR = (5.0, 5.0)         # Gamma(shape, rate) of the marginal precisi
 RHO_PRIOR = (1.0, 0.1)              # Beta(a, b) of each rho_k
 LAMBDA_N_PRIOR = (3.0, 0.003)       # Gamma(shape, rate) of the nugget precision
 LOG_BOUNDS = {"lambda_w": (-6.0, 8.0), "beta": (np.log(1e-4), np.log(2e3)), "lambda_n": (0.0, 25.0)}
+KERNELS = ("gaussian", "matern52", "matern32")
+SQRT3, SQRT5 = np.sqrt(3.0), np.sqrt(5.0)
 
 
-def squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Per-dimension squared differences, shape (len(a), len(b), d)."""
-    return (a[:, None, :] - b[None, :, :]) ** 2
+def kernel(r2: np.ndarray, family: str) -> tuple[np.ndarray, np.ndarray]:
+    """Correlation c(r^2) and its derivative dc/d(r^2) for a correlation family."""
+    if family == "gaussian":
+        c = np.exp(-r2)
+        return c, -c
+    s = np.sqrt(r2)
+    if family == "matern52":
+        e = np.exp(-SQRT5 * s)
+        return (1.0 + SQRT5 * s + (5.0 / 3.0) * r2) * e, -(5.0 / 6.0) * (1.0 + SQRT5 * s) * e
+    if family == "matern32":
+        e = np.exp(-SQRT3 * s)
+        return (1.0 + SQRT3 * s) * e, -1.5 * e
+    raise ValueError(f"unknown correlation family {family!r}; expected one of {KERNELS}")
 
 
-def correlation(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """exp(-sum_k beta_k (a_k - b_k)^2) via a matrix product (no (n, m, d) temporary)."""
+def scaled_distances(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """r^2 = sum_k beta_k (a_k - b_k)^2 via a matrix product (no (n, m, d) temporary)."""
     sa, sb = a * np.sqrt(beta), b * np.sqrt(beta)
-    d2 = (sa**2).sum(1)[:, None] + (sb**2).sum(1)[None, :] - 2.0 * sa @ sb.T
-    return np.exp(-np.maximum(d2, 0.0))
+    return np.maximum((sa**2).sum(1)[:, None] + (sb**2).sum(1)[None, :] - 2.0 * sa @ sb.T, 0.0)
+
+
+def correlation(a: np.ndarray, b: np.ndarray, beta: np.ndarray, family: str = "gaussian") -> np.ndarray:
+    """Correlation matrix between the rows of a and b."""
+    return kernel(scaled_distances(a, b, beta), family)[0]
 
 
 @dataclass
 class Hyper:
-    """Hyperparameters of one GP."""
+    """Hyperparameters of one GP (the constant mean is profiled, not optimised)."""
 
     lambda_w: float
     beta: np.ndarray
     lambda_n: float
+    mean: float = 0.0
 
     def pack(self) -> np.ndarray:
         return np.concatenate([[np.log(self.lambda_w)], np.log(self.beta), [np.log(self.lambda_n)]])
 
     @classmethod
-    def unpack(cls, phi: np.ndarray) -> "Hyper":
-        return cls(float(np.exp(phi[0])), np.exp(phi[1:-1]), float(np.exp(phi[-1])))
+    def unpack(cls, phi: np.ndarray, mean: float = 0.0) -> "Hyper":
+        return cls(float(np.exp(phi[0])), np.exp(phi[1:-1]), float(np.exp(phi[-1])), float(mean))
 
 
 def log_prior(phi: np.ndarray) -> tuple[float, np.ndarray]:
@@ -77,45 +96,63 @@ def _inverse_from_cholesky(lower: np.ndarray) -> np.ndarray:
     return np.tril(inv) + np.tril(inv, -1).T
 
 
-def neg_log_posterior(phi: np.ndarray, x: np.ndarray, y: np.ndarray, d2: np.ndarray, jitter: float):
-    """Negative log marginal posterior of the hyperparameters and its analytic gradient."""
+def _gls_mean(factor, y: np.ndarray) -> float:
+    """Generalised-least-squares constant mean 1'K^-1 y / 1'K^-1 1."""
+    k_inv_1 = linalg.cho_solve(factor, np.ones(len(y)), check_finite=False)
+    return float(k_inv_1 @ y / k_inv_1.sum())
+
+
+def neg_log_posterior(phi: np.ndarray, x: np.ndarray, y: np.ndarray, family: str, jitter: float,
+                      fit_mean: bool) -> tuple[float, np.ndarray]:
+    """Negative log marginal posterior of the hyperparameters and its analytic gradient.
+
+    Distances and the length-scale gradient go through matrix products (no (n, n, d) table). With
+    `fit_mean` the constant mean is profiled out at its GLS estimate (no extra gradient term there).
+    """
     hyp = Hyper.unpack(phi)
     n = len(y)
-    corr = np.exp(-(d2 @ hyp.beta))
-    cov = corr / hyp.lambda_w + (1.0 / hyp.lambda_n + jitter) * np.eye(n)
+    r2 = scaled_distances(x, x, hyp.beta)
+    r2.flat[::n + 1] = 0.0
+    corr, slope = kernel(r2, family)
+    cov = corr / hyp.lambda_w
+    cov.flat[::n + 1] += 1.0 / hyp.lambda_n + jitter
     try:
         factor = linalg.cho_factor(cov, lower=True, check_finite=False)
     except linalg.LinAlgError:
         return np.inf, np.zeros_like(phi)
-    alpha = linalg.cho_solve(factor, y, check_finite=False)
+    resid = y - _gls_mean(factor, y) if fit_mean else y
+    alpha = linalg.cho_solve(factor, resid, check_finite=False)
     inv = _inverse_from_cholesky(factor[0])
     logdet = 2.0 * np.log(np.diag(factor[0])).sum()
-    nll = 0.5 * y @ alpha + 0.5 * logdet
+    nll = 0.5 * resid @ alpha + 0.5 * logdet
     w = inv - np.outer(alpha, alpha)            # d nll / d cov = w / 2
-    wc = w * corr
     grad = np.empty_like(phi)
-    grad[0] = -0.5 * wc.sum() / hyp.lambda_w
-    grad[1:-1] = -0.5 * hyp.beta * (wc.ravel() @ d2.reshape(n * n, -1)) / hyp.lambda_w
+    grad[0] = -0.5 * (w * corr).sum() / hyp.lambda_w
+    # sum_ij m_ij (x_ik - x_jk)^2 = 2 sum_i x_ik^2 sum_j m_ij - 2 x_k' m x_k for symmetric m
+    m = w * slope
+    pair_sums = 2.0 * (m.sum(1) @ x**2 - np.einsum("ik,ik->k", x, m @ x))
+    grad[1:-1] = 0.5 * hyp.beta * pair_sums / hyp.lambda_w
     grad[-1] = -0.5 * np.trace(w) / hyp.lambda_n
     lp, lp_grad = log_prior(phi)
     return nll - lp, grad - lp_grad
 
 
 class GaussianProcess:
-    """A zero-mean GP conditioned on (x, y): prediction, closed-form leave-one-out."""
+    """A GP conditioned on (x, y): prediction, closed-form leave-one-out."""
 
-    def __init__(self, x: np.ndarray, y: np.ndarray, hyper: Hyper, jitter: float = 1e-8):
+    def __init__(self, x: np.ndarray, y: np.ndarray, hyper: Hyper, jitter: float = 1e-8, family: str = "gaussian"):
         self.x = np.asarray(x, dtype=float)
         self.y = np.asarray(y, dtype=float)
-        self.hyper = hyper
-        self.jitter = jitter
-        cov = self.prior_cov(self.x, self.x) + (1.0 / hyper.lambda_n + jitter) * np.eye(len(y))
-        factor = linalg.cho_factor(cov, lower=True)
-        self.alpha = linalg.cho_solve(factor, self.y)
-        self.inv_cov = _inverse_from_cholesky(factor[0])
+        self.hyper, self.jitter, self.family = hyper, jitter, family
+        cov = self.prior_cov(self.x, self.x)
+        cov.flat[::len(self.y) + 1] += 1.0 / hyper.lambda_n + jitter
+        self.factor = linalg.cho_factor(cov, lower=True)
+        self.alpha = linalg.cho_solve(self.factor, self.y - hyper.mean)
+        self.inv_cov = _inverse_from_cholesky(self.factor[0])
 
     @classmethod
-    def fit(cls, x, y, n_starts: int = 4, seed: int = 0, jitter: float = 1e-8, fit_rows=None) -> "GaussianProcess":
+    def fit(cls, x, y, n_starts: int = 4, seed: int = 0, jitter: float = 1e-8, fit_rows=None,
+            family: str = "gaussian", fit_mean: bool = False) -> "GaussianProcess":
         """MAP hyperparameters (L-BFGS-B from several starts), then condition on all of (x, y).
 
         `fit_rows` restricts the hyperparameter fit to a subset of rows (for speed on large
@@ -123,9 +160,8 @@ class GaussianProcess:
         """
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         xs, ys = (x, y) if fit_rows is None else (x[fit_rows], y[fit_rows])
-        d2 = squared_distances(xs, xs)
-        rng = np.random.default_rng(seed)
         dim = x.shape[1]
+        rng = np.random.default_rng(seed)
         bounds = [LOG_BOUNDS["lambda_w"]] + [LOG_BOUNDS["beta"]] * dim + [LOG_BOUNDS["lambda_n"]]
         starts = [np.concatenate([[0.0], np.full(dim, np.log(b)), [np.log(1e3)]]) for b in (1.0, 5.0)]
         while len(starts) < n_starts:
@@ -133,20 +169,26 @@ class GaussianProcess:
                                           [rng.uniform(3.0, 12.0)]]))
         best = None
         for phi0 in starts[:max(n_starts, 1)]:
-            res = optimize.minimize(neg_log_posterior, phi0, args=(xs, ys, d2, jitter), jac=True,
+            res = optimize.minimize(neg_log_posterior, phi0, args=(xs, ys, family, jitter, fit_mean), jac=True,
                                     method="L-BFGS-B", bounds=bounds)
             if best is None or res.fun < best.fun:
                 best = res
-        return cls(x, y, Hyper.unpack(best.x), jitter)
+        hyper = Hyper.unpack(best.x)
+        if fit_mean:
+            cov = correlation(x, x, hyper.beta, family) / hyper.lambda_w
+            cov.flat[::len(y) + 1] += 1.0 / hyper.lambda_n + jitter
+            hyper.mean = _gls_mean(linalg.cho_factor(cov, lower=True), y)
+        return cls(x, y, hyper, jitter, family)
 
     def prior_cov(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return correlation(a, b, self.hyper.beta) / self.hyper.lambda_w
+        return correlation(a, b, self.hyper.beta, self.family) / self.hyper.lambda_w
 
     def predict(self, x_new: np.ndarray, include_nugget: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance at `x_new` (the nugget is part of a new observation)."""
         k = self.prior_cov(np.asarray(x_new, dtype=float), self.x)
-        mean = k @ self.alpha
-        var = 1.0 / self.hyper.lambda_w - np.einsum("ij,ij->i", k @ self.inv_cov, k)
+        mean = self.hyper.mean + k @ self.alpha
+        v = linalg.solve_triangular(self.factor[0], k.T, lower=True, check_finite=False)
+        var = 1.0 / self.hyper.lambda_w - np.einsum("ij,ij->j", v, v)
         if include_nugget:
             var = var + 1.0 / self.hyper.lambda_n + self.jitter
         return mean, np.maximum(var, 0.0)
@@ -155,7 +197,7 @@ class GaussianProcess:
         """Predictive mean and full covariance (no nugget) at `x_new`: for drawing smooth functions."""
         x_new = np.asarray(x_new, dtype=float)
         k = self.prior_cov(x_new, self.x)
-        return k @ self.alpha, self.prior_cov(x_new, x_new) - k @ self.inv_cov @ k.T
+        return self.hyper.mean + k @ self.alpha, self.prior_cov(x_new, x_new) - k @ self.inv_cov @ k.T
 
     def loo(self) -> tuple[np.ndarray, np.ndarray]:
         """Leave-one-out predictive mean and variance in closed form (hyperparameters fixed)."""

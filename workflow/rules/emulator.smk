@@ -1,4 +1,6 @@
-# Emulator: PC-GP on the design and every shot's features, with its leave-one-out table.
+# Emulator: PC-GP on the design and every shot's features, with its cross-validation: closed-form LOO
+# (cv.parquet, the fast diagnostic), K-fold and the outer check (cv_heldout.parquet), all in cv_rmse.csv
+# with a `scheme` column.
 
 
 rule emulator:
@@ -9,6 +11,7 @@ rule emulator:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",
         cv=f"{RESULTS}/emulator/cv.parquet",
+        heldout=f"{RESULTS}/emulator/cv_heldout.parquet",
         rmse=f"{RESULTS}/emulator/cv_rmse.csv",
     params:
         emulator=config["emulator"],
@@ -19,7 +22,7 @@ rule emulator:
         f"{LOGS}/emulator.log",
     benchmark:
         f"{BENCHMARKS}/emulator.tsv"
-    threads: 2
+    threads: config["emulator"]["n_jobs"]
     conda:
         "../envs/shockcal.yaml"
     shell:

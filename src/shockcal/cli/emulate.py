@@ -1,23 +1,38 @@
-"""`shockcal emulate`: fit the PC-GP emulator to design + features and write its LOO cross-validation."""
+"""`shockcal emulate`, `emulate-cv`, `emulate-predict`: fit the PC-GP emulator and cross-validate it;
+its cross-validation table; its predictions on a design table."""
 
 from __future__ import annotations
 
 from shockcal.cli import add_config_argument, parse_pairs
 
+HELD_OUT = ("kfold", "outer")
+UNITS = {"simulated": "m/s", "predicted": "m/s", "predicted_sd": "m/s"}
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("emulate", help="fit the emulator; write it and its leave-one-out table")
+    p = subparsers.add_parser("emulate", help="fit the emulator; write it and its cross-validation tables")
     add_config_argument(p)
     p.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
                    help="per-shot feature tables (CSV or Parquet), joined to the design on `run`")
     p.add_argument("--structure", choices=["per_shot", "joint"], help="override emulator.structure")
-    p.add_argument("--out", required=True, help="output directory (emulator.json, emulator.npz, cv.parquet, cv_rmse.csv)")
+    p.add_argument("--out", required=True,
+                   help="output directory (emulator.json, emulator.npz, cv.parquet, cv_heldout.parquet, cv_rmse.csv)")
     p.set_defaults(func=run)
 
-    cv = subparsers.add_parser("emulate-cv", help="print the leave-one-out RMSE table of a fitted emulator")
+    cv = subparsers.add_parser("emulate-cv", help="print the cross-validation table of a fitted emulator "
+                                                  "(loo_closed_form, kfold, outer)")
     cv.add_argument("--emulator", required=True, help="emulator directory")
+    cv.add_argument("--folds", type=int, help="recompute K-fold with this many folds (refits per fold)")
+    cv.add_argument("--margin", type=float, help="recompute the outer check with this inner-box margin")
     cv.set_defaults(func=print_cv)
+
+    pr = subparsers.add_parser("emulate-predict", help="emulator mean and sd of every feature at every design run")
+    add_config_argument(pr)
+    pr.add_argument("--emulator", required=True, help="emulator directory")
+    pr.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
+    pr.add_argument("--out", required=True, help="output Parquet: run, shot, feature, mean, sd (m/s)")
+    pr.set_defaults(func=predict)
 
 
 def run(args) -> int:
@@ -26,8 +41,8 @@ def run(args) -> int:
 
     from shockcal.config import load_config, shot_config
     from shockcal.design import load_design
-    from shockcal.emulator import fit_emulator, rmse_table
-    from shockcal.io import read_table, write_table
+    from shockcal.emulator import fit_emulator
+    from shockcal.io import read_table
 
     config = load_config(args.config)
     if args.structure:
@@ -40,20 +55,71 @@ def run(args) -> int:
     emulator = fit_emulator(config, design, features, sources=paths)
     out = Path(args.out)
     emulator.save(out)
-    cv = emulator.cv_table()
-    write_table(cv, out / "cv.parquet", {"table": "emulator leave-one-out", "structure": emulator.structure,
-                                         "units": {"simulated": "m/s", "predicted": "m/s", "predicted_sd": "m/s"}})
-    table = rmse_table(cv)
-    table.to_csv(out / "cv_rmse.csv", index=False)
-    logging.getLogger("shockcal.emulate").info("leave-one-out RMSE (m/s):\n%s", table.to_string(index=False))
+    settings = config["emulator"]
+    table = write_cv(emulator, out, ["loo_closed_form", *HELD_OUT], settings["cv_folds"], settings["outer_margin"])
+    logging.getLogger("shockcal.emulate").info("cross-validation (m/s):\n%s", table.to_string(index=False))
     return 0
+
+
+def write_cv(emulator, out, schemes, folds: int, margin: float):
+    """Write cv.parquet (closed-form LOO) and/or cv_heldout.parquet (K-fold, outer); return the RMSE table."""
+    import pandas as pd
+
+    from shockcal.emulator import rmse_table
+    from shockcal.io import read_table, write_table
+
+    if "loo_closed_form" in schemes:
+        write_table(emulator.cv_table("loo_closed_form"), out / "cv.parquet",
+                    {"table": "emulator closed-form leave-one-out (hyperparameters fixed: a fast diagnostic)",
+                     "structure": emulator.structure, "units": UNITS})
+    held = pd.concat([emulator.cv_table(s, folds=folds, margin=margin) for s in HELD_OUT], ignore_index=True)
+    write_table(held, out / "cv_heldout.parquet",
+                {"table": "emulator held-out predictions", "structure": emulator.structure, "units": UNITS,
+                 "kfold": f"{folds} seeded folds, everything refitted per fold",
+                 "outer": f"trained on scaled inputs in [{margin}, {1 - margin}], predicting the others"})
+    table = rmse_table(pd.concat([read_table(out / "cv.parquet"), held], ignore_index=True))
+    table.to_csv(out / "cv_rmse.csv", index=False)
+    return table
 
 
 def print_cv(args) -> int:
     from pathlib import Path
 
-    from shockcal.emulator import rmse_table
+    import pandas as pd
+
+    from shockcal.emulator import Emulator, rmse_table
     from shockcal.io import read_table
 
-    print(rmse_table(read_table(Path(args.emulator) / "cv.parquet")).to_string(index=False))
+    out = Path(args.emulator)
+    if args.folds is not None or args.margin is not None:
+        table = write_cv(Emulator.load(out), out, HELD_OUT, args.folds or 10, 0.05 if args.margin is None else args.margin)
+    else:
+        held = [read_table(out / "cv_heldout.parquet")] if (out / "cv_heldout.parquet").is_file() else []
+        table = rmse_table(pd.concat([read_table(out / "cv.parquet"), *held], ignore_index=True))
+    print(table.to_string(index=False))
+    return 0
+
+
+def predict(args) -> int:
+    import numpy as np
+    import pandas as pd
+
+    from shockcal.config import load_config
+    from shockcal.design import load_design
+    from shockcal.emulator import Emulator
+    from shockcal.io import write_table
+
+    config = load_config(args.config)
+    emulator = Emulator.load(args.emulator)
+    design = load_design(args.design, config, columns=emulator.required_inputs(emulator.shots))
+    inputs = {k: design[k].to_numpy(float) for k in emulator.required_inputs(emulator.shots)}
+    mean, cov = emulator.predict(inputs, emulator.shots)
+    sd = np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
+    names = [(shot, feature) for shot in emulator.shots for feature in emulator.feature_names]
+    table = pd.DataFrame({"run": np.repeat(design["run"].to_numpy(), len(names)),
+                          "shot": np.tile([s for s, _ in names], len(design)),
+                          "feature": np.tile([f for _, f in names], len(design)),
+                          "mean": mean.ravel(), "sd": sd.ravel()})
+    write_table(table, args.out, {"table": "emulator predictions", "design": args.design,
+                                  "emulator": args.emulator, "units": {"mean": "m/s", "sd": "m/s"}})
     return 0
