@@ -1,9 +1,10 @@
-"""Emulator speed and accuracy: fit + leave-one-out, and prediction of mean and covariance.
+"""Emulator speed and accuracy: fit + cross-validation, and prediction of mean and covariance.
 
-Prints, for both structures: fit + LOO wall time and LOO RMSE on the paper's FLAG features
-(runs 0-499, real data), fit + LOO time on 1000 runs (the paper's design with a smooth synthetic
-12-feature response, since FLAG features exist only for 500 runs), and the time to predict mean
-and covariance of all 12 features at 1000 inputs.
+Prints, with the load average next to every timing (the machine is shared): on the paper's FLAG
+features (runs 0-499, real data), fit + K-fold + outer-check wall time and the RMSE and 90% coverage
+of each scheme; fit + K-fold on 1000 runs (the paper's design with a smooth synthetic 12-feature
+response, since FLAG features exist only for 500 runs); the time to predict mean and covariance of
+all 12 features at 1000 inputs with one and two BLAS threads.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from threadpoolctl import threadpool_limits
 
 from shockcal.config import load_config
 from shockcal.emulator import CALIBRATION_FEATURES, fit_emulator, rmse_table
@@ -22,10 +24,14 @@ REPO = Path(__file__).resolve().parents[1]
 SHOTS = ["104S", "105S", "106S"]
 
 
+def load() -> str:
+    return "load " + " ".join(Path("/proc/loadavg").read_text().split()[:3])
+
+
 def synthetic_features(design: pd.DataFrame, config: dict) -> dict[str, pd.DataFrame]:
     """Smooth stand-in features on the full design (velocities in m/s, plausible magnitudes)."""
     out = {}
-    for i, shot in enumerate(SHOTS):
+    for shot in SHOTS:
         v = design[config["shots"][shot]["velocity_input"]] * 1e4
         a, b, n = design["A"] / 0.01, design["B"] / 0.01, design["n"] / 1.5
         y = np.column_stack([40 + 60 * a + 10 * b * n, 0.97 * v - 5 * a, 50 + 60 * a + 15 * np.sin(3 * b),
@@ -34,35 +40,49 @@ def synthetic_features(design: pd.DataFrame, config: dict) -> dict[str, pd.DataF
     return out
 
 
-def timed_fit(config, design, features):
+def timed(label, fn):
     start = time.perf_counter()
-    emulator = fit_emulator(config, design, features)
-    cv = emulator.cv_table()
-    return emulator, cv, time.perf_counter() - start
+    result = fn()
+    print(f"  {label}: {time.perf_counter() - start:6.1f} s ({load()})")
+    return result
 
 
 def main() -> None:
     config = load_config(REPO / "config" / "config.yaml")
+    settings = config["emulator"]
+    print(f"emulator settings: {settings}")
     ref = reference_dir()
     if ref is None:
         print("reference data not found: skipping the FLAG part")
-    design = pd.read_csv(ref / "design.csv") if ref else None
-    for structure in ("joint", "per_shot"):
-        config["emulator"]["structure"] = structure
-        if ref:
-            flag = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
-            emulator, cv, seconds = timed_fit(config, design, flag)
-            overall = rmse_table(cv).iloc[-1]
-            print(f"{structure:9s} FLAG 500 runs: fit + LOO {seconds:6.1f} s, LOO RMSE {overall['rmse_m_s']:.2f} m/s, "
-                  f"90% coverage {overall['coverage90']:.3f}")
-            inputs = {k: design[k].to_numpy() for k in design.columns if k != "run"}
+        return
+    design = pd.read_csv(ref / "design.csv")
+    inputs = {k: design[k].to_numpy() for k in design.columns if k != "run"}
+    flag = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
+    print("FLAG features, runs 0-499 (joint):")
+    emulator = timed("fit", lambda: fit_emulator(config, design, flag))
+    cv = [timed("closed-form LOO", lambda: emulator.cv_table("loo_closed_form"))]
+    cv.append(timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"])))
+    cv.append(timed("outer check", lambda: emulator.cv_table("outer", margin=settings["outer_margin"])))
+    table = rmse_table(pd.concat(cv, ignore_index=True))
+    print(table[table["shot"] == "all"].to_string(index=False))
+    for threads in (1, 2):
+        with threadpool_limits(threads, user_api="blas"):
+            emulator.predict(inputs, SHOTS)
             start = time.perf_counter()
             emulator.predict(inputs, SHOTS)
-            print(f"{structure:9s} predict mean + cov of 12 features at 1000 inputs: "
-                  f"{1e3 * (time.perf_counter() - start):.0f} ms")
-        if design is not None:
-            _, _, seconds = timed_fit(config, design, synthetic_features(design, config))
-            print(f"{structure:9s} 1000 runs x 12 features (synthetic response): fit + LOO {seconds:6.1f} s")
+            print(f"  predict mean + cov of 12 features at 1000 inputs, {threads} BLAS thread(s): "
+                  f"{1e3 * (time.perf_counter() - start):.0f} ms ({load()})")
+    print("1000 runs x 12 features (synthetic response):")
+    start = time.perf_counter()
+    emulator = timed("fit", lambda: fit_emulator(config, design, synthetic_features(design, config)))
+    timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"]))
+    print(f"  fit + K-fold: {time.perf_counter() - start:.1f} s ({load()})")
+    with threadpool_limits(1, user_api="blas"):
+        emulator.predict(inputs, SHOTS)
+        start = time.perf_counter()
+        emulator.predict(inputs, SHOTS)
+        print(f"  predict mean + cov at 1000 inputs, 1 BLAS thread: {1e3 * (time.perf_counter() - start):.0f} ms "
+              f"({load()})")
 
 
 if __name__ == "__main__":

@@ -61,7 +61,7 @@ def _synthetic_study(paper_config, n=60, seed=3):
 
 def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
     design, features, _ = _synthetic_study(paper_config, n=90)
-    paper_config["emulator"].update(structure="per_shot", n_starts=2)
+    paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
     emulator = fit_emulator(paper_config, design, {"104S": features})
     table = rmse_table(emulator.cv_table())
     overall = table.iloc[-1]
@@ -76,7 +76,7 @@ def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
 
 def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path, paper_config):
     design, features, _ = _synthetic_study(paper_config, n=30)
-    paper_config["emulator"].update(n_starts=1)
+    paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(paper_config, design, {"104S": features, "106S": features})
     loaded = Emulator.load(emulator.save(tmp_path / "emu"))
     inputs = {k: design[k].to_numpy()[:5] for k in design.columns}
@@ -97,7 +97,7 @@ def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
     design, features, _ = _synthetic_study(paper_config, n=30)
     features.loc[0, "status"] = "failed"
     features.loc[1, "v_plastic"] = np.nan
-    paper_config["emulator"].update(n_starts=1)
+    paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(paper_config, design, {"104S": features})
     assert len(emulator.blocks[0].runs) == 28
     assert "2 of 30 runs dropped" in caplog.text
@@ -123,7 +123,7 @@ def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
     features.to_parquet(tmp_path / "f.parquet")
     quick = tmp_path / "c.yaml"
     import yaml
-    paper_config["emulator"]["n_starts"] = 1
+    paper_config["emulator"].update(n_starts=1, cv_folds=3)
     quick.write_text(yaml.safe_dump(paper_config))
     assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
                  "--features", f"104S={tmp_path / 'f.parquet'}", "--out", str(tmp_path / "emu")]) == 0

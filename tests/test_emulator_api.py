@@ -66,7 +66,7 @@ def _problem(n=60, seed=6):
 
 def test_kfold_equals_brute_force_refits():
     X, Y, lower, upper = _problem(n=24)
-    settings = Settings(family="matern52", n_starts=1, seed=3)
+    settings = Settings(family="matern52", n_starts=1, seed=3, calibrate_sd=False)
     emulator = PCGPEmulator.fit(X, Y, lower, upper, settings)
     cv = emulator.cross_validate(4, seed=1)
     assert sorted(cv.rows) == list(range(24))
@@ -79,9 +79,23 @@ def test_kfold_equals_brute_force_refits():
         np.testing.assert_allclose(cv.sd[at], np.sqrt(np.einsum("nff->nf", cov)), rtol=1e-10)
 
 
+def test_sd_calibration_is_one_factor_per_feature_from_the_kfold():
+    X, Y, lower, upper = _problem(n=40)
+    raw = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=5, calibrate_sd=False))
+    calibrated = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=5))
+    held = raw.cross_validate(5)
+    z = np.abs(held.mean - Y[held.rows]) / held.sd
+    np.testing.assert_allclose(calibrated.sd_factor, np.quantile(z, 0.9, axis=0) / 1.6449)
+    (m0, c0), (m1, c1) = raw.predict(X[:5]), calibrated.predict(X[:5])
+    np.testing.assert_array_equal(m0, m1)
+    np.testing.assert_allclose(np.sqrt(np.einsum("nff->nf", c1)), np.sqrt(np.einsum("nff->nf", c0)) * calibrated.sd_factor)
+    cv = calibrated.cross_validate(5)                     # each fold scaled by the other folds' factors
+    assert np.all(cv.sd != held.sd) and np.array_equal(cv.mean, held.mean)
+
+
 def test_arrays_api_fits_predicts_saves_and_loads(tmp_path):
     X, Y, lower, upper = _problem(n=60)
-    emulator = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1))
+    emulator = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=4))
     X_new, Y_new, _, _ = _problem(n=50, seed=7)
     mean, cov = emulator.predict(X_new)
     assert mean.shape == (50, 3) and cov.shape == (50, 3, 3)
@@ -105,7 +119,7 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
     design = latin_hypercube(paper_config, 30, 1)
     features = pd.DataFrame({f: 100 + 50 * design["A"] / 0.01 + 10 * i + 1e3 * design["V1"]
                              for i, f in enumerate(CALIBRATION_FEATURES)}).assign(run=design["run"])
-    paper_config["emulator"].update(n_starts=1)
+    paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(paper_config, design, {"104S": features, "105S": features})
     emulator.save(tmp_path / "emu")
     new = latin_hypercube(paper_config, 7, 2).assign(run=lambda d: d["run"] + 100)

@@ -34,6 +34,7 @@ from shockcal.gp import GaussianProcess, Hyper
 
 FORMAT_VERSION = 2
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
+Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
 log = logging.getLogger("shockcal.emulator")
 
 
@@ -101,10 +102,12 @@ class Settings:
     max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
     seed: int = 0
     n_jobs: int = 1                # processes for the GP fits (one BLAS thread each)
+    cv_folds: int = 10             # K-fold of the sd calibration
+    calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
 
     @classmethod
     def from_config(cls, settings: dict, seed: int) -> "Settings":
-        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs")
+        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
 
 
@@ -133,12 +136,14 @@ class PCGPEmulator:
     """
 
     def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings):
+                 settings: Settings, sd_factor=None):
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
         self.residual_cov = np.asarray(residual_cov)
         self.x_train, self.y_train = np.asarray(x_train, dtype=float), np.asarray(y_train, dtype=float)
         self.settings = settings
+        self.sd_factor = np.ones(len(self.mean)) if sd_factor is None else np.asarray(sd_factor, dtype=float)
+        self.kfold: HeldOut | None = None          # the K-fold of the sd calibration, kept for reporting
         self.weights = self.project((self.y_train - self.mean) / self.scale)
         self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h, family=settings.family)
                     for j, h in enumerate(hypers)]
@@ -152,8 +157,18 @@ class PCGPEmulator:
 
     @classmethod
     def fit(cls, X, Y, lower, upper, settings: Settings | None = None) -> "PCGPEmulator":
-        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode."""
-        return cls._fit_many(X, Y, lower, upper, settings or Settings(), [np.arange(len(Y))])[0]
+        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode.
+
+        With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
+        quantile of its K-fold |error| / sd over 1.645 (one factor per feature, never per run).
+        """
+        settings = settings or Settings()
+        model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))])[0]
+        if settings.calibrate_sd:
+            held, folds = model._kfold(settings.cv_folds, settings.seed)
+            model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
+            model.kfold = _cross_fitted(model, held, folds)
+        return model
 
     @classmethod
     def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets) -> list["PCGPEmulator"]:
@@ -200,7 +215,7 @@ class PCGPEmulator:
             w_mean[:, j], w_var[:, j] = gp.predict(x)
         z_cov = np.einsum("nj,jf,jg->nfg", w_var, self.basis, self.basis) + self.residual_cov
         mean = self.mean + (w_mean @ self.basis) * self.scale
-        return mean, z_cov * np.outer(self.scale, self.scale)
+        return mean, z_cov * np.outer(self.scale * self.sd_factor, self.scale * self.sd_factor)
 
     def loo(self) -> HeldOut:
         """Closed-form leave-one-out (hyperparameters and basis fixed): a fast diagnostic that flatters."""
@@ -210,15 +225,26 @@ class PCGPEmulator:
             w_mean[:, j], w_var[:, j] = gp.loo()
         z_var = w_var @ self.basis**2 + np.diag(self.residual_cov)
         return HeldOut("loo_closed_form", np.arange(len(self.y_train)),
-                       self.mean + (w_mean @ self.basis) * self.scale, np.sqrt(z_var) * self.scale)
+                       self.mean + (w_mean @ self.basis) * self.scale, np.sqrt(z_var) * self.scale * self.sd_factor)
 
     def cross_validate(self, k: int = 10, seed: int | None = None) -> HeldOut:
-        """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold."""
+        """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold.
+
+        With `calibrate_sd`, each fold's sd is scaled by factors estimated from the other folds.
+        """
+        seed = self.settings.seed if seed is None else seed
+        if self.kfold is not None and (k, seed) == (self.settings.cv_folds, self.settings.seed):
+            return self.kfold
+        held, folds = self._kfold(k, seed)
+        return _cross_fitted(self, held, folds) if self.settings.calibrate_sd else held
+
+    def _kfold(self, k: int, seed: int) -> tuple[HeldOut, list[np.ndarray]]:
+        """K-fold held-out predictions with the fold models' own sd, and the folds."""
         n = len(self.y_train)
-        order = np.random.default_rng(self.settings.seed if seed is None else seed).permutation(n)
+        order = np.random.default_rng(seed).permutation(n)
         folds = [np.sort(f) for f in np.array_split(order, min(k, n))]
         trains = [np.setdiff1d(np.arange(n), f) for f in folds]
-        return self._held_out("kfold", folds, trains)
+        return self._held_out("kfold", folds, trains), folds
 
     def outer_check(self, margin: float = 0.05) -> HeldOut:
         """Train on runs with every scaled input in [margin, 1 - margin]; predict the others (near faces)."""
@@ -228,7 +254,9 @@ class PCGPEmulator:
                         self.x_train.shape[1] + 2)
             empty = np.empty((0, self.y_train.shape[1]))
             return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
-        return self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
+        held = self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
+        held.sd *= self.sd_factor
+        return held
 
     def _held_out(self, scheme, tests, trains) -> HeldOut:
         models = self._fit_many(self.x_train, self.y_train, np.zeros(len(self.lower)), np.ones(len(self.upper)),
@@ -245,7 +273,7 @@ class PCGPEmulator:
     def to_arrays(self, prefix: str = "") -> dict:
         arrays = {"lower": self.lower, "upper": self.upper, "mean": self.mean, "scale": self.scale,
                   "basis": self.basis, "residual_cov": self.residual_cov, "x_train": self.x_train,
-                  "y_train": self.y_train}
+                  "y_train": self.y_train, "sd_factor": self.sd_factor}
         return {f"{prefix}{k}": v for k, v in arrays.items()}
 
     def to_json(self) -> dict:
@@ -257,7 +285,8 @@ class PCGPEmulator:
     def from_saved(cls, meta: dict, arrays, prefix: str = "") -> "PCGPEmulator":
         hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
-        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]))
+        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
+                   arrays[f"{prefix}sd_factor"])
 
     def save(self, path) -> Path:
         """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
@@ -274,6 +303,21 @@ class PCGPEmulator:
         if header.get("format") != "shockcal-pcgp" or header.get("version") != FORMAT_VERSION:
             raise InputError(f"{path}: not a shockcal PC-GP emulator of version {FORMAT_VERSION}")
         return cls.from_saved(header, arrays)
+
+
+def _sd_factor(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> np.ndarray:
+    """Per feature: 90% quantile of |error| / sd over the rows `use` of a held-out set, over 1.645."""
+    z = np.abs(held.mean[use] - model.y_train[held.rows[use]]) / held.sd[use]
+    return np.quantile(z, 0.9, axis=0) / Z90
+
+
+def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
+    """K-fold sd scaled, fold by fold, by the factors of the other folds (an honest coverage)."""
+    fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
+    sd = held.sd.copy()
+    for j in range(len(folds)):
+        sd[fold_of == j] *= _sd_factor(model, held, fold_of != j)
+    return HeldOut(held.scheme, held.rows, held.mean, sd)
 
 
 def _component_count(singular_values: np.ndarray, n_components: float) -> int:
@@ -471,7 +515,7 @@ def fit_emulator(config: dict, design: pd.DataFrame, features: dict[str, pd.Data
 def rmse_table(cv: pd.DataFrame) -> pd.DataFrame:
     """Per scheme, shot and feature: RMSE, bias (m/s) and 90%-band coverage, plus an overall row per scheme."""
     err = cv["predicted"] - cv["simulated"]
-    inside = (err.abs() <= 1.6449 * cv["predicted_sd"])
+    inside = (err.abs() <= Z90 * cv["predicted_sd"])
     frame = cv.assign(sq=err**2, err=err, inside=inside)
     aggregates = dict(rmse_m_s=("sq", "mean"), bias_m_s=("err", "mean"), coverage90=("inside", "mean"))
     per = frame.groupby(["scheme", "shot", "feature"], sort=False).agg(**aggregates).reset_index()
