@@ -88,7 +88,8 @@ def test_sd_calibration_is_one_factor_per_feature_from_the_kfold():
     np.testing.assert_allclose(calibrated.sd_factor, np.quantile(z, 0.9, axis=0) / 1.6449)
     (m0, c0), (m1, c1) = raw.predict(X[:5]), calibrated.predict(X[:5])
     np.testing.assert_array_equal(m0, m1)
-    np.testing.assert_allclose(np.sqrt(np.einsum("nff->nf", c1)), np.sqrt(np.einsum("nff->nf", c0)) * calibrated.sd_factor)
+    sd0, sd1 = np.sqrt(np.einsum("nff->nf", c0)), np.sqrt(np.einsum("nff->nf", c1))
+    np.testing.assert_allclose(sd1, sd0 * calibrated.sd_factor)
     cv = calibrated.cross_validate(5)                     # each fold scaled by the other folds' factors
     assert np.all(cv.sd != held.sd) and np.array_equal(cv.mean, held.mean)
 
@@ -121,6 +122,9 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
                              for i, f in enumerate(CALIBRATION_FEATURES)}).assign(run=design["run"])
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(paper_config, design, {"104S": features, "105S": features})
+    input_map = emulator.blocks[0].input_map
+    strain = paper_config["emulator"]["hardening_strain"]
+    np.testing.assert_allclose(input_map.raw(design)[:, -1], strain ** design["n"])
     emulator.save(tmp_path / "emu")
     new = latin_hypercube(paper_config, 7, 2).assign(run=lambda d: d["run"] + 100)
     new.to_csv(tmp_path / "new.csv", index=False)

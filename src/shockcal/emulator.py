@@ -1,19 +1,21 @@
 """Principal-component Gaussian-process emulator of the calibration features (SPEC section 5).
 
-Features y (m/s) of each training run are standardized per feature (mean vector, sd vector),
-projected on an orthogonal basis from the SVD of the standardized training outputs, and each basis
-weight gets its own GP (`shockcal.gp`) over inputs scaled to [0, 1] by the prior box. Prediction
-returns the mean and covariance in feature space (m/s), adding the covariance of what the
-truncated basis leaves out (the training residuals' covariance).
+`PCGPEmulator` works on plain arrays (inputs X in a box, outputs Y): outputs are standardized per
+column, projected on an orthogonal basis from the SVD of the standardized training outputs, and each
+basis weight gets its own GP (`shockcal.gp`) over inputs scaled to [0, 1]. Prediction returns the mean
+and covariance of the outputs, adding the covariance of what the truncated basis leaves out, with each
+output's sd scaled by a factor calibrated by K-fold. Cross-validation: closed-form LOO (diagnostic),
+K-fold and the outer check (everything refitted).
 
-Two structures (config `emulator.structure`):
+The study's `Emulator` (from `fit_emulator`) maps design columns to emulator inputs, in one of two
+structures (config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
 
 Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units,
-hyperparameters); loading rebuilds the Cholesky factors, so files stay small and no live object
-is pickled.
+settings, hyperparameters); loading rebuilds the Cholesky factors, so files stay small and no live
+object is pickled.
 """
 
 from __future__ import annotations
@@ -40,30 +42,37 @@ log = logging.getLogger("shockcal.emulator")
 
 @dataclass
 class InputMap:
-    """How one emulator's inputs derive from design inputs: each is a sum of design columns."""
+    """How one emulator's inputs derive from design inputs: each is a sum of design columns, plus,
+    when `strain` > 0, a last input strain^n (the Johnson-Cook hardening factor at that plastic
+    strain: steep in n near 0, where the elastic precursor changes fastest)."""
 
     names: list[str]            # emulator input names, e.g. [A, B, C, n, m, V2, G_105S]
     terms: list[list[str]]      # design columns summed into each input
-    lower: np.ndarray           # box of each input (sum of the terms' bounds)
+    lower: np.ndarray           # box of each input (sum of the terms' bounds), strain^n last
     upper: np.ndarray
+    strain: float = 0.0
 
     def design_inputs(self) -> list[str]:
         return list(dict.fromkeys(t for terms in self.terms for t in terms))
 
     def raw(self, inputs) -> np.ndarray:
-        """(N, d) inputs (sums of design columns) from a mapping or DataFrame of design columns."""
-        return np.column_stack([sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms])
+        """(N, d) inputs (sums of design columns, strain^n) from a mapping or DataFrame of design columns."""
+        raw = [sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms]
+        if self.strain:
+            raw.append(self.strain ** np.asarray(inputs["n"], dtype=float))
+        return np.column_stack(raw)
 
     def scaled(self, inputs) -> np.ndarray:
         """(N, d) inputs scaled to [0, 1] by the box."""
         return (self.raw(inputs) - self.lower) / (self.upper - self.lower)
 
     def to_json(self) -> dict:
-        return {"names": self.names, "terms": self.terms, "lower": self.lower.tolist(), "upper": self.upper.tolist()}
+        return {"names": self.names, "terms": self.terms, "lower": self.lower.tolist(), "upper": self.upper.tolist(),
+                "strain": self.strain}
 
     @classmethod
     def from_json(cls, d: dict) -> "InputMap":
-        return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]))
+        return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]), d["strain"])
 
 
 def shot_input_map(config: dict, shot: str) -> InputMap:
@@ -86,9 +95,13 @@ def _shot_terms(config, shot):
 
 
 def _box_map(config, names, terms) -> InputMap:
-    lower = np.array([sum(config["inputs"][t]["min"] for t in ts) for ts in terms])
-    upper = np.array([sum(config["inputs"][t]["max"] for t in ts) for ts in terms])
-    return InputMap(names, terms, lower, upper)
+    lower = [sum(config["inputs"][t]["min"] for t in ts) for ts in terms]
+    upper = [sum(config["inputs"][t]["max"] for t in ts) for ts in terms]
+    strain = config["emulator"]["hardening_strain"]
+    if strain:
+        lower.append(strain ** config["inputs"]["n"]["max"])
+        upper.append(strain ** config["inputs"]["n"]["min"])
+    return InputMap(names, terms, np.array(lower), np.array(upper), strain)
 
 
 @dataclass
@@ -122,6 +135,7 @@ class HeldOut:
 
 
 def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int) -> Hyper:
+    """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
                                    family=settings.family, fit_mean=settings.fit_mean).hyper
@@ -188,7 +202,8 @@ class PCGPEmulator:
             basis = vt[:p] * (s[:p, None] / np.sqrt(n))       # z ~ weights @ basis
             residual = z - weights @ basis
             rng = np.random.default_rng(settings.seed)
-            fit_rows = None if n <= settings.max_fit_runs else np.sort(rng.choice(n, settings.max_fit_runs, replace=False))
+            fit_rows = (None if n <= settings.max_fit_runs
+                        else np.sort(rng.choice(n, settings.max_fit_runs, replace=False)))
             parts.append((x, y, mean, scale, basis, residual.T @ residual / n))
             tasks += [(x, weights[:, j], fit_rows, settings, settings.seed + j) for j in range(p)]
         if settings.n_jobs > 1:
@@ -246,9 +261,11 @@ class PCGPEmulator:
         trains = [np.setdiff1d(np.arange(n), f) for f in folds]
         return self._held_out("kfold", folds, trains), folds
 
-    def outer_check(self, margin: float = 0.05) -> HeldOut:
-        """Train on runs with every scaled input in [margin, 1 - margin]; predict the others (near faces)."""
-        inner = np.all((self.x_train >= margin) & (self.x_train <= 1 - margin), axis=1)
+    def outer_check(self, margin: float = 0.05, columns=None) -> HeldOut:
+        """Train on runs with every scaled input (of `columns`, default all) in [margin, 1 - margin];
+        predict the others (near the faces)."""
+        x = self.x_train if columns is None else self.x_train[:, columns]
+        inner = np.all((x >= margin) & (x <= 1 - margin), axis=1)
         if inner.sum() < self.x_train.shape[1] + 2:
             log.warning("outer check skipped: %d runs inside the inner box, %d needed", inner.sum(),
                         self.x_train.shape[1] + 2)
@@ -396,13 +413,14 @@ class Emulator:
         """Held-out table (run, shot, feature, simulated, predicted, predicted_sd in m/s, scheme).
 
         Schemes: `loo_closed_form` (fast diagnostic, hyperparameters fixed), `kfold` (everything
-        refitted per fold) and `outer` (trained on the inner box [margin, 1 - margin], predicting the rest).
+        refitted per fold) and `outer` (trained on runs whose design inputs are all in the inner box
+        [margin, 1 - margin], predicting the rest).
         """
         k = len(self.feature_names)
         parts = []
         for block in self.blocks:
             held = {"loo_closed_form": block.model.loo, "kfold": lambda: block.model.cross_validate(folds),
-                    "outer": lambda: block.model.outer_check(margin)}[scheme]()
+                    "outer": lambda: block.model.outer_check(margin, np.arange(len(block.input_map.terms)))}[scheme]()
             for i, shot in enumerate(block.shots):
                 for f, feature in enumerate(self.feature_names):
                     col = k * i + f

@@ -92,7 +92,8 @@ def print_cv(args) -> int:
 
     out = Path(args.emulator)
     if args.folds is not None or args.margin is not None:
-        table = write_cv(Emulator.load(out), out, HELD_OUT, args.folds or 10, 0.05 if args.margin is None else args.margin)
+        margin = 0.05 if args.margin is None else args.margin
+        table = write_cv(Emulator.load(out), out, HELD_OUT, args.folds or 10, margin)
     else:
         held = [read_table(out / "cv_heldout.parquet")] if (out / "cv_heldout.parquet").is_file() else []
         table = rmse_table(pd.concat([read_table(out / "cv.parquet"), *held], ignore_index=True))
