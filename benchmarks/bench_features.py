@@ -2,7 +2,7 @@
 
 Times `features_table` (the `shockcal features` code path) on 30 simulated-like traces (two-step
 Gaussian-CDF traces with varied arrival, plateaus and rise widths on the 0.5 ns grid of a 4 us run,
-8001 points) and `extract_features` on the three measured records (when ../shared/data is present),
+8001 points) and `extract_features` on the three measured records shipped in data/al5083,
 after a warm-up. Both are timed with the default thread pools and with one thread each: scikit-learn's
 k-means initialization uses OpenMP, which costs more than it saves on 1-D data on a busy machine.
 Timings are inflated when other jobs share the machine: the load average is printed with them.
@@ -19,13 +19,12 @@ import pandas as pd
 from scipy.stats import norm
 from threadpoolctl import threadpool_limits
 
-from shockcal.cli.features import SEED_OFFSET
 from shockcal.config import load_config
 from shockcal.features import extract_features, features_table
 from shockcal.records import read_record
-from shockcal.reference import reference_dir
 
-CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
+REPO = Path(__file__).resolve().parents[1]
+CONFIG = REPO / "config" / "config.yaml"
 SHOT = "104S"
 N_TRACES = 30
 REPEATS = 3
@@ -60,20 +59,15 @@ def _seconds(function) -> float:
 
 def main() -> None:
     config = load_config(CONFIG)
-    seed = config["study"]["seed"] + SEED_OFFSET
     traces = simulated_like(N_TRACES)
     cases = {f"{N_TRACES} simulated-like traces ({SHOT} window)":
-             (lambda: features_table(traces, config, SHOT, seed), N_TRACES)}
-    ref = reference_dir()
-    if ref is None:
-        print("reference data not found: skipping the measured records")
-    else:
-        records = {shot: read_record(ref / "visar" / f"Data_S{shot}.txt") for shot in config["shots"]}
-        for shot, (t, v) in records.items():
-            cases[f"measured record {shot} ({len(t)} points)"] = (
-                lambda t=t, v=v, shot=shot: extract_features(t, v, config["shots"][shot]["analysis"],
-                                                             config["features"], seed), 1)
-    features_table(traces.head(1), config, SHOT, seed)  # warm-up: imports, first fit
+             (lambda: features_table(traces, config, SHOT), N_TRACES)}
+    for shot, spec in config["observed"]["records"].items():
+        t, v = read_record(REPO / spec["path"])
+        cases[f"measured record {shot} ({len(t)} points)"] = (
+            lambda t=t, v=v, shot=shot: extract_features(t, v, config["shots"][shot]["analysis"],
+                                                         config["features"]), 1)
+    features_table(traces.head(1), config, SHOT)  # warm-up: imports, first fit
     print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (timings inflated when high)")
     print(f"{'':45}{'ms/trace':>10}{'1 thread':>10}   goal {GOAL_MS:.0f}")
     for name, (function, count) in cases.items():

@@ -1,11 +1,13 @@
 """Our hydrocode + feature extractor against the paper's FLAG features (`make validate`).
 
 Simulates design runs 0..N-1 of the paper's design (../shared/data/al5083/design.csv) with the paper
-config, extracts their features with `features_table` (the `shockcal features` code path and seeds),
+config, extracts their features with `features_table` (the `shockcal features` code path),
 and prints per shot and feature the RMSE and bias (ours - FLAG) against flag_features_<shot>.csv,
-in m/s and ns, next to the goals: RMSE <= 3 m/s for the elastic and plastic plateaus, <= 6 m/s for
-the slope points, and jump-off time within 0.5% once the constant offset between the codes' clocks
-is removed. Then the features of the measured records against the published ones. Two processes.
+in m/s and ns, next to the goals: RMSE <= 1.5 m/s for the elastic plateau, <= 2.5 m/s for the plastic
+plateau, <= 4 m/s for the slope points, the mean rise time (t_slope2 - t_slope1) within 15 ns of FLAG's,
+and jump-off time within 0.5% once the constant offset between the codes' clocks is removed. Then the
+features of the measured records against the published ones. Two processes; the features table is
+written to benchmarks/out/validate_flag_features.parquet.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.cli.features import SEED_OFFSET, record_features
+from shockcal.cli.features import record_features
 from shockcal.config import load_config
 from shockcal.errors import InputError
 from shockcal.features import COLUMNS, features_table
@@ -31,13 +33,15 @@ SHOTS = ["104S", "105S", "106S"]
 FLAG_RUNS = 500  # FLAG features exist for runs 0-499
 CHUNK = 5        # design rows per task
 PROCESSES = 2
-RMSE_GOALS_M_S = {"v_elastic": 3.0, "v_plastic": 3.0, "v_slope1": 6.0, "v_slope2": 6.0}
+RMSE_GOALS_M_S = {"v_elastic": 1.5, "v_plastic": 2.5, "v_slope1": 4.0, "v_slope2": 4.0}
+RISE_BIAS_GOAL_NS = 15.0
 JUMPOFF_GOAL_PERCENT = 0.5
+OUT = Path(__file__).resolve().parent / "out" / "validate_flag_features.parquet"
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=100, help="design runs 0..N-1 per shot (default 100, at most 500)")
+    parser.add_argument("--runs", type=int, default=FLAG_RUNS, help="design runs 0..N-1 per shot (default and most: 500)")
     parser.add_argument("--shots", nargs="+", default=SHOTS, choices=SHOTS)
     args = parser.parse_args(argv)
     if not 1 <= args.runs <= FLAG_RUNS:
@@ -52,7 +56,7 @@ def simulate_chunk(task) -> pd.DataFrame:
     shot, rows, config = task
     with threadpool_limits(1):
         traces = simulate_design(rows, config, shot)
-        return features_table(traces, config, shot, config["study"]["seed"] + SEED_OFFSET).assign(shot=shot)
+        return features_table(traces, config, shot).assign(shot=shot)
 
 
 def compare(ours: pd.DataFrame, flag: pd.DataFrame) -> pd.DataFrame:
@@ -73,6 +77,13 @@ def jumpoff_after_offset(ours: pd.DataFrame, flag: pd.DataFrame) -> tuple[float,
     return 1e3 * rmse, 100 * rmse / float(flag.loc[ok.index, "t_jumpoff"].mean())
 
 
+def rise_time_difference(ours: pd.DataFrame, flag: pd.DataFrame) -> pd.Series:
+    """Plastic rise time t_slope2 - t_slope1, ours - FLAG, per run (ns)."""
+    ok = ours[ours["status"] == "ok"].set_index("run")
+    theirs = flag.loc[ok.index]
+    return 1e3 * ((ok["t_slope2"] - ok["t_slope1"]) - (theirs["t_slope2"] - theirs["t_slope1"]))
+
+
 def print_shot(shot: str, ours: pd.DataFrame, flag: pd.DataFrame) -> None:
     failed = ours[ours["status"] != "ok"]
     print(f"\nshot {shot}: {len(ours)} runs, {len(ours) - len(failed)} with features")
@@ -82,8 +93,11 @@ def print_shot(shot: str, ours: pd.DataFrame, flag: pd.DataFrame) -> None:
     print(f"  {'feature':11}{'unit':>5}{'RMSE':>9}{'bias':>9}   goal (RMSE)")
     for column, row in table.iterrows():
         goal = RMSE_GOALS_M_S.get(column)
-        verdict = "" if goal is None else f"<= {goal:.0f} m/s  {'met' if row.rmse <= goal else 'NOT met'}"
+        verdict = "" if goal is None else f"<= {goal:g} m/s  {'met' if row.rmse <= goal else 'NOT met'}"
         print(f"  {column:11}{row.unit:>5}{row.rmse:9.2f}{row.bias:+9.2f}   {verdict}")
+    rise = rise_time_difference(ours, flag)
+    print(f"  rise time t_slope2 - t_slope1: bias {rise.mean():+.1f} ns, RMSE {np.sqrt((rise ** 2).mean()):.1f} ns   "
+          f"goal |bias| <= {RISE_BIAS_GOAL_NS:.0f} ns  {'met' if abs(rise.mean()) <= RISE_BIAS_GOAL_NS else 'NOT met'}")
     rmse_ns, percent = jumpoff_after_offset(ours, flag)
     print(f"  jump-off time without its offset ({table.loc['t_jumpoff', 'bias']:+.1f} ns): RMSE {rmse_ns:.2f} ns = "
           f"{percent:.2f}% of FLAG's   goal <= {JUMPOFF_GOAL_PERCENT}%  "
@@ -117,6 +131,8 @@ def main(argv=None) -> int:
     with Pool(PROCESSES) as pool:
         ours = pd.concat(pool.imap_unordered(simulate_chunk, tasks), ignore_index=True)
     wall = time.perf_counter() - start
+    OUT.parent.mkdir(exist_ok=True)
+    ours.to_parquet(OUT)
     for shot in args.shots:
         flag = pd.read_csv(ref / f"flag_features_{shot}.csv").set_index("run")
         print_shot(shot, ours[ours["shot"] == shot].sort_values("run"), flag)

@@ -62,8 +62,18 @@ def test_unquoted_shot_names_become_strings(tmp_path, paper_config):
     shots = paper_config["shots"]
     paper_config["shots"] = {104: shots["104S"]}
     paper_config["observed"]["features"] = {}
+    paper_config["observed"]["records"] = {104: paper_config["observed"]["records"]["104S"]}
     validate_config(paper_config)
     assert list(paper_config["shots"]) == ["104"]
+    assert list(paper_config["observed"]["records"]) == ["104"]
+
+
+@pytest.mark.parametrize("source, section", [("records", "records"), ("published", "features")])
+def test_every_shot_needs_an_entry_for_the_observed_source(paper_config, source, section):
+    paper_config["observed"]["source"] = source
+    del paper_config["observed"][section]["105S"]
+    with pytest.raises(ConfigError, match=rf"observed\.{section}\.105S: missing, and observed\.source is '{source}'"):
+        validate_config(paper_config)
 
 
 def test_unreadable_files(tmp_path):

@@ -110,6 +110,12 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for shot, record in observed["records"].items():
         if not Path(record["path"]).is_file():
             raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
+    source_section = "records" if observed["source"] == "records" else "features"
+    for shot in config["shots"]:
+        if shot not in observed[source_section]:
+            raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
+                              f"{observed['source']!r}; give it, or set observed.source to "
+                              f"{'published' if source_section == 'records' else 'records'}")
     if design_file:
         from shockcal.design import load_design  # shockcal.design imports this module
 

@@ -12,9 +12,15 @@
    surface). Measured records carry pre-trigger content and a baseline offset: both are outside
    the window or removed by the standardization below.
 3. The windowed trace is standardized to run from 0 to 1, made monotone (running maximum) and read
-   as a CDF; 10,000 samples are drawn by the probability integral transform (uniform draws mapped
-   through the inverse CDF, linear interpolation of (y, t)).
-4. A k = 5 Gaussian mixture (scikit-learn, seeded) is fitted; components with mu + 2 sigma < c,
+   as a CDF; 10,000 samples are drawn by the probability integral transform: stratified uniform
+   draws u_i = (i + 1/2)/N (no random numbers) mapped through the inverse CDF, linear interpolation
+   of (y, t). The samples move smoothly with the trace, so neighbouring runs get neighbouring samples.
+4. A k = 5 Gaussian mixture (scikit-learn) is fitted by EM from `MIXTURE_STARTS` fixed starts (means
+   at the samples' k quantiles, then k-means starts seeded 0, 1, ...), each run to convergence
+   (`MIXTURE_TOL`, far below scikit-learn's default 1e-3, which stops on a plateau of the
+   likelihood); the start of highest likelihood is kept. The features are a deterministic function of
+   the trace: no seed, and a perturbation of 1e-6 of the rise moves them by far less than 1e-3 m/s.
+   Components with mu + 2 sigma < c,
    c = arrival + `cutoff_after_arrival_us`, form the early (elastic) mixture, the rest the late one.
    A trace with a single wave (elastic only at large A, or a precursor merged with the plastic
    rise) puts every component on one side: then the latest (resp. earliest) component is taken as
@@ -39,6 +45,9 @@ QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0
 PRE_ARRIVAL_US = 0.05
 PLASTIC_LEVEL = 0.995
+MIXTURE_STARTS = 3         # EM starts: quantile-spaced means, then k-means seeded 0, 1, ...
+MIXTURE_TOL = 1e-5         # EM stops when the mean log-likelihood gains less than this
+MIXTURE_MAX_ITER = 1000
 
 
 class FeatureError(ValueError):
@@ -102,10 +111,8 @@ def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
 
 
 def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float, n_components: int = 5,
-            n_samples: int = 10000, seed: int = 0) -> Extraction:
+            n_samples: int = 10000) -> Extraction:
     """Run the extractor on one trace (t in us, v in m/s); raises FeatureError when it cannot."""
-    from sklearn.mixture import GaussianMixture
-
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
     bad = ~(np.isfinite(t) & np.isfinite(v))
     if bad.any():
@@ -118,10 +125,8 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     tw, vw = t[inside], v[inside]
     y = np.maximum.accumulate((vw - vw.min()) / (vw.max() - vw.min()))
     rising = np.diff(y, prepend=-1.0) > 0
-    rng = np.random.default_rng(seed)
-    samples = np.interp(rng.uniform(size=n_samples), y[rising], tw[rising])
-    gm = GaussianMixture(n_components, random_state=seed).fit(samples[:, None])
-    mixture = Mixture(gm.weights_, gm.means_.ravel(), np.sqrt(gm.covariances_.ravel()))
+    samples = np.interp((np.arange(n_samples) + 0.5) / n_samples, y[rising], tw[rising])
+    mixture = fit_mixture(samples, n_components)
     cutoff = arrival + cutoff_after_arrival_us
     early = mixture.means + 2 * mixture.sds < cutoff
     if early.all():          # one wave only (elastic, large A): its latest component is the late mixture
@@ -141,18 +146,36 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
 
 
-def extract_features(t, v, analysis: dict, settings: dict, seed: int = 0) -> dict:
+def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
+    """The EM fit of highest likelihood over `MIXTURE_STARTS` fixed starts. EM runs on the standardized
+    samples, so the tolerance and scikit-learn's variance floor (reg_covar) do not depend on the time unit."""
+    from sklearn.mixture import GaussianMixture
+
+    centre, spread = samples.mean(), samples.std()
+    z = ((samples - centre) / spread)[:, None]
+    quantile_means = np.quantile(z, (np.arange(n_components) + 0.5) / n_components)[:, None]
+    starts = [dict(means_init=quantile_means, random_state=0)]
+    starts += [dict(random_state=k) for k in range(MIXTURE_STARTS - 1)]
+    best, best_score = None, -np.inf
+    for start in starts:
+        gm = GaussianMixture(n_components, tol=MIXTURE_TOL, max_iter=MIXTURE_MAX_ITER, **start).fit(z)
+        score = gm.score(z)
+        if score > best_score:
+            best, best_score = gm, score
+    return Mixture(best.weights_, centre + spread * best.means_.ravel(), spread * np.sqrt(best.covariances_.ravel()))
+
+
+def extract_features(t, v, analysis: dict, settings: dict) -> dict:
     """The ten feature values of a trace with the config's per-shot analysis and features settings."""
     return extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
-                   settings["n_components"], settings["n_samples"], seed).features
+                   settings["n_components"], settings["n_samples"]).features
 
 
-def features_table(traces, config: dict, shot: str, seed: int) -> "pd.DataFrame":
+def features_table(traces, config: dict, shot: str) -> "pd.DataFrame":
     """One row per simulated run: run, status, reason and the ten features.
 
     Failed simulations keep their status and reason; a trace the extractor cannot read becomes
-    status "failed" with the extractor's reason. Each run's mixture seed is `seed + run`, so a run's
-    features do not depend on which chunk or batch it was extracted in.
+    status "failed" with the extractor's reason.
     """
     import pandas as pd
 
@@ -162,7 +185,7 @@ def features_table(traces, config: dict, shot: str, seed: int) -> "pd.DataFrame"
         row = {"run": int(record["run"]), "status": record["status"], "reason": record["reason"]}
         if record["status"] == "ok":
             try:
-                row.update(extract_features(record["t_us"], record["v_m_s"], analysis, settings, seed + row["run"]))
+                row.update(extract_features(record["t_us"], record["v_m_s"], analysis, settings))
             except FeatureError as exc:
                 row.update(status="failed", reason=f"feature extraction: {exc}")
         rows.append(row)

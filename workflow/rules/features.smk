@@ -22,7 +22,9 @@ rule features:
 
 rule observed:
     input:
-        [record["path"] for record in config["observed"]["records"].values()],
+        [spec["path"] for spec in config["observed"]["records"].values()]
+        if config["observed"]["source"] == "records"
+        else [],
     output:
         f"{RESULTS}/features/observed.parquet",
     params:

@@ -7,7 +7,6 @@ import logging
 from shockcal.cli import add_config_argument
 
 log = logging.getLogger("shockcal.features")
-SEED_OFFSET = 3  # feature sampling uses study.seed + SEED_OFFSET (+ run id)
 UNITS = {"t_*": "us", "v_*": "m/s"}
 
 
@@ -37,7 +36,6 @@ def run(args) -> int:
 
     config = load_config(args.config)
     shot_config(config, args.shot)
-    seed = config["study"]["seed"] + SEED_OFFSET
     if args.record:
         table = pd.DataFrame([{"run": 0, "status": "ok", "reason": "",
                                **record_features(config, args.shot, args.record, args.time_column,
@@ -46,7 +44,7 @@ def run(args) -> int:
         from shockcal.features import features_table
 
         traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
-        table = features_table(traces, config, args.shot, seed)
+        table = features_table(traces, config, args.shot)
         check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
     write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,
                                   "analysis": config["shots"][args.shot]["analysis"]})
@@ -62,8 +60,7 @@ def record_features(config, shot, path, time_column=None, velocity_column=None) 
 
     t, v = read_record(path, _column(time_column), _column(velocity_column))
     try:
-        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"],
-                                config["study"]["seed"] + SEED_OFFSET)
+        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"])
     except FeatureError as exc:
         raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
 
@@ -91,23 +88,20 @@ def run_observed(args) -> int:
     import pandas as pd
 
     from shockcal.config import load_config
-    from shockcal.errors import ConfigError
     from shockcal.features import COLUMNS
     from shockcal.io import write_table
 
     config = load_config(args.config)
     observed = config["observed"]
     rows = []
-    for shot in config["shots"]:
-        if shot in observed["records"]:
+    for shot in config["shots"]:      # load_config checked that every shot has its source's entry
+        if observed["source"] == "records":
             spec = observed["records"][shot]
-            rows.append({"shot": shot, "source": f"record {spec['path']}",
+            rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
                          **record_features(config, shot, spec["path"], spec["time_column"], spec["velocity_column"])})
-        elif shot in observed["features"]:
-            rows.append({"shot": shot, "source": "config observed.features (Walters et al. 2018, LA-UR-18-20151)",
-                         **observed["features"][shot]})
         else:
-            raise ConfigError(f"{args.config}: shot {shot} has neither observed.features.{shot} nor observed.records.{shot}")
+            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
+                         **observed["features"][shot]})
     table = pd.DataFrame(rows)[["shot", "source", *COLUMNS]]
     write_table(table, args.out, {"table": "observed features", "units": UNITS})
     log.info("observed features:\n%s", table.drop(columns="source").to_string(index=False))

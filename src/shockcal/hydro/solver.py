@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
-from shockcal.hydro.strength import hardening, radial_return, rate_factor, thermal_factor
+from shockcal.hydro.strength import flow_stress, hardening, radial_return, thermal_factor
 
 J_PER_KG = 1.0e-8          # 1 J/kg in (cm/us)^2
 PER_S = 1.0e-6             # 1 /s in 1/us
@@ -87,7 +87,6 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
     s = np.zeros(N + 1)
     sigma = np.zeros(N + 1)
     eps_p = np.zeros(N + 1)
-    plastic_rate = np.zeros(N + 1)
     hard = np.full(N + 1, hardening(A, B, n, 0.0))
     # a lower bound of each cell's flow stress, valid while its temperature stays <= floor_T:
     # a trial stress inside it is elastic without evaluating pow/log (JC rate factor >= 1, thermal
@@ -152,14 +151,13 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
                 s_new, d_eps = s_trial, 0.0
             else:
                 thermal = thermal_factor(m, (T_cell - T_ref) * inv_T_range)
-                flow = hard[j] * rate_factor(C, plastic_rate[j], rate_ref) * thermal
+                flow = flow_stress(hard[j], thermal, C, strain_rate, rate_ref)
                 s_new, d_eps = radial_return(s_trial, flow, G)
                 if d_eps > 0.0:
                     eps_p[j] += d_eps
                     hard[j] = hardening(A, B, n, eps_p[j])
                 flow_floor[j] = hard[j] * thermal     # the rate factor is >= 1, thermal(T) falls with T
                 floor_T[j] = T_cell
-            plastic_rate[j] = d_eps / dt
             # energy: dE = -(P + q) dV + s_mean * strain_rate * dt / rho, P implicit (trapezoid)
             dV = dt * du / cell_mass[j]
             work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
@@ -174,7 +172,7 @@ def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, 
             length[j] = new_length
             sigma[j] = -(P[j] + q_new) + s_new
             if j > gap:
-                max_rate = max(max_rate, plastic_rate[j])
+                max_rate = max(max_rate, d_eps / dt)      # plastic rate: a diagnostic only
                 max_T = max(max_T, T_ref + E_new / cv)
                 max_eps = max(max_eps, eps_p[j])
             # 4. time step: dt = cfl L / (a + sqrt(a^2 + c^2)), a the viscous signal speed

@@ -1,10 +1,14 @@
 """Johnson-Cook flow stress and von Mises radial return in uniaxial strain (SPEC section 2).
 
-    Y = (A + B eps_p^n) (1 + C ln(epsdot_p / epsdot_0)) (1 - T*^m),  T* = (T - T_ref)/(T_melt - T_ref)
+    Y = (A + B eps_p^n) (1 + C ln(epsdot / epsdot_0)) (1 - T*^m),  T* = (T - T_ref)/(T_melt - T_ref)
 
 Conventions (also in docs/hydro.md):
-- the rate ratio is floored at 1: ln(max(epsdot_p / epsdot_0, 1)), so the rate term never softens;
-- the plastic strain rate is the previous step's (explicit lag), as in most explicit hydrocodes;
+- epsdot is the current step's total equivalent strain rate, (2/3)|d eps_xx/dt| in uniaxial strain
+  (the usual explicit-code convention, and the one that reproduces FLAG's features). The paper writes
+  the plastic rate; taken from the previous step (an explicit lag) it makes the rate term vanish
+  wherever the stress relaxes slowly: a numerical artefact, not physics. The plastic rate is kept
+  as a diagnostic only;
+- the rate ratio is floored at 1: ln(max(epsdot / epsdot_0, 1)), so the rate term never softens;
 - n = 0 means eps_p^0 = 1 (Y = A + B), including at eps_p = 0;
 - T* <= 0 gives no thermal softening; T* >= 1 gives Y = 0 (melt);
 - m -> 0: T*^m -> 1 for any T* > 0, so the material loses its strength as soon as it heats at all;
@@ -34,6 +38,18 @@ def rate_factor(C, strain_rate, strain_rate_ref):
     """1 + C ln(max(rate/rate_ref, 1))."""
     ratio = strain_rate / strain_rate_ref
     return 1.0 + C * math.log(ratio) if ratio > 1.0 else 1.0
+
+
+@njit(cache=True, error_model="numpy")
+def equivalent_strain_rate(strain_rate_xx):
+    """Von Mises equivalent of a uniaxial-strain rate: (2/3)|d eps_xx/dt| (same unit as the input)."""
+    return (2.0 / 3.0) * abs(strain_rate_xx)
+
+
+@njit(cache=True, error_model="numpy")
+def flow_stress(hardening_stress, thermal, C, strain_rate_xx, strain_rate_ref):
+    """Johnson-Cook flow stress (Mbar) from A + B eps_p^n, 1 - T*^m and the current total strain rate."""
+    return hardening_stress * rate_factor(C, equivalent_strain_rate(strain_rate_xx), strain_rate_ref) * thermal
 
 
 @njit(cache=True, error_model="numpy")

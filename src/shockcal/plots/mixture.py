@@ -51,7 +51,7 @@ def extract_view(trace: pd.DataFrame, config: dict, shot: str) -> TraceExtractio
     t, v = trace["t_us"].to_numpy(float), trace["v_m_s"].to_numpy(float)
     analysis, settings = config["shots"][shot]["analysis"], config["features"]
     ex = extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
-                 settings["n_components"], settings["n_samples"], seed=config["study"]["seed"])
+                 settings["n_components"], settings["n_samples"])
     return TraceExtraction(t, v, ex)
 
 
