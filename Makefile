@@ -6,7 +6,7 @@ INSTALLED := $(VENV)/.installed
 CORES ?= all
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick test test-slow bench validate lint clean
+.PHONY: study quick test test-slow test-slurm bench validate lint clean
 
 $(INSTALLED): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -27,6 +27,9 @@ test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 
 test-slow: $(INSTALLED)  ## the slow checks only
 	$(VENV)/bin/pytest -m slow
+
+test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (root: installs slurm-wlm, munge)
+	tests/slurm/run_slurm_test.sh
 
 bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted)
 	@for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
