@@ -26,19 +26,22 @@ KERNELS = ("gaussian", "matern52", "matern32")
 SQRT3, SQRT5 = np.sqrt(3.0), np.sqrt(5.0)
 
 
-def kernel(r2: np.ndarray, family: str) -> tuple[np.ndarray, np.ndarray]:
-    """Correlation c(r^2) and its derivative dc/d(r^2) for a correlation family."""
+def kernel(r2: np.ndarray, family: str, slope: bool = True):
+    """Correlation c(r^2) and, with `slope`, its derivative dc/d(r^2), for a correlation family."""
     if family == "gaussian":
         c = np.exp(-r2)
-        return c, -c
+        return (c, -c) if slope else c
+    if family not in KERNELS:
+        raise ValueError(f"unknown correlation family {family!r}; expected one of {KERNELS}")
+    root = SQRT5 if family == "matern52" else SQRT3
     s = np.sqrt(r2)
-    if family == "matern52":
-        e = np.exp(-SQRT5 * s)
-        return (1.0 + SQRT5 * s + (5.0 / 3.0) * r2) * e, -(5.0 / 6.0) * (1.0 + SQRT5 * s) * e
-    if family == "matern32":
-        e = np.exp(-SQRT3 * s)
-        return (1.0 + SQRT3 * s) * e, -1.5 * e
-    raise ValueError(f"unknown correlation family {family!r}; expected one of {KERNELS}")
+    s *= root                                   # s = root * r
+    e = np.exp(-s)
+    if family == "matern52":                    # (1 + s + s^2/3) e,  dc/dr^2 = -(5/6)(1 + s) e
+        c = (1.0 + s + s * s / 3.0) * e
+        return (c, -(5.0 / 6.0) * (1.0 + s) * e) if slope else c
+    c = (1.0 + s) * e                           # Matern 3/2: (1 + s) e,  dc/dr^2 = -(3/2) e
+    return (c, -1.5 * e) if slope else c
 
 
 def scaled_distances(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -49,7 +52,7 @@ def scaled_distances(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarr
 
 def correlation(a: np.ndarray, b: np.ndarray, beta: np.ndarray, family: str = "gaussian") -> np.ndarray:
     """Correlation matrix between the rows of a and b."""
-    return kernel(scaled_distances(a, b, beta), family)[0]
+    return kernel(scaled_distances(a, b, beta), family, slope=False)
 
 
 @dataclass
@@ -60,9 +63,6 @@ class Hyper:
     beta: np.ndarray
     lambda_n: float
     mean: float = 0.0
-
-    def pack(self) -> np.ndarray:
-        return np.concatenate([[np.log(self.lambda_w)], np.log(self.beta), [np.log(self.lambda_n)]])
 
     @classmethod
     def unpack(cls, phi: np.ndarray, mean: float = 0.0) -> "Hyper":
