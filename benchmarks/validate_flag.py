@@ -7,7 +7,7 @@ in m/s and ns, next to the goals: RMSE <= 1.5 m/s for the elastic plateau, <= 2.
 plateau, <= 4 m/s for the slope points, the mean rise time (t_slope2 - t_slope1) within 15 ns of FLAG's,
 and jump-off time within 0.5% once the constant offset between the codes' clocks is removed. Then the
 features of the measured records against the published ones. Two processes; the features table is
-written to benchmarks/out/validate_flag_features.parquet.
+written to benchmarks/out/validate_flag_features.parquet (`--out`).
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=FLAG_RUNS, help="design runs 0..N-1 per shot (default and most: 500)")
     parser.add_argument("--shots", nargs="+", default=SHOTS, choices=SHOTS)
+    parser.add_argument("--out", type=Path, default=OUT, help=f"features table written here (default {OUT})")
     args = parser.parse_args(argv)
     if not 1 <= args.runs <= FLAG_RUNS:
         parser.error(f"--runs must be between 1 and {FLAG_RUNS} (the FLAG runs)")
@@ -131,8 +132,8 @@ def main(argv=None) -> int:
     with Pool(PROCESSES) as pool:
         ours = pd.concat(pool.imap_unordered(simulate_chunk, tasks), ignore_index=True)
     wall = time.perf_counter() - start
-    OUT.parent.mkdir(exist_ok=True)
-    ours.to_parquet(OUT)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    ours.to_parquet(args.out)
     for shot in args.shots:
         flag = pd.read_csv(ref / f"flag_features_{shot}.csv").set_index("run")
         print_shot(shot, ours[ours["shot"] == shot].sort_values("run"), flag)

@@ -1,7 +1,8 @@
 """Figure 2: the measured free-surface velocity records, one panel per shot, on the experiment clock.
 
-A shot with a record file configured (observed.records) shows the record and its published
-features; a shot without one shows only the measured features, and says so.
+A shot with a record file configured (observed.records) shows the record and its measured features
+(the observed table: extracted from the record, or the published values with observed.source:
+published); a shot without one shows only the measured features, and says so.
 """
 
 from __future__ import annotations
