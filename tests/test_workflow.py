@@ -139,8 +139,8 @@ def test_added_design_rows_run_only_new_chunks(study, tmp_path):
 def test_added_shot_runs_only_its_simulations(study, tmp_path):
     quick = load_config(REPO / "config" / "config.yaml")
     new_shot = dict(quick["shots"]["106S"], target_mm=4.0)
-    observed = dict(quick["observed"]["features"]["106S"])
-    more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"features": {"107S": observed}})
+    record = dict(quick["observed"]["records"]["106S"])          # a fourth shot comes with its record
+    more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"records": {"107S": record}})
     jobs = pending_jobs(study[1], more)
     assert jobs["simulate"] == 4                               # the 4 chunks of 107S only
     assert jobs["features"] == 1
