@@ -19,7 +19,8 @@
    at the samples' k quantiles, then k-means starts seeded 0, 1, ...), each run to convergence
    (`MIXTURE_TOL`, far below scikit-learn's default 1e-3, which stops on a plateau of the
    likelihood); the start of highest likelihood is kept. The features are a deterministic function of
-   the trace: no seed, and a perturbation of 1e-6 of the rise moves them by far less than 1e-3 m/s.
+   the trace (no seed); a perturbation of 1e-6 of the rise moves them by 0.005 m/s or ns (median over
+   hydrocode traces), more only where two EM optima nearly tie (docs/features.md, "Stability").
    Components with mu + 2 sigma < c,
    c = arrival + `cutoff_after_arrival_us`, form the early (elastic) mixture, the rest the late one.
    A trace with a single wave (elastic only at large A, or a precursor merged with the plastic

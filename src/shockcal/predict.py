@@ -60,3 +60,12 @@ def emulator_predictions(emulator, design: pd.DataFrame, shots: list[str]) -> pd
         part.insert(0, "run", design["run"].to_numpy())
         parts.append(part)
     return pd.concat(parts, ignore_index=True)
+
+
+def emulator_predictions_long(emulator, design: pd.DataFrame, shots: list[str]) -> pd.DataFrame:
+    """`emulator_predictions` with one row per (run, shot, feature): run, shot, feature, mean, sd (m/s)."""
+    wide = emulator_predictions(emulator, design, shots)
+    names = list(emulator.feature_names)
+    table = wide.melt(id_vars=["run", "shot"], value_vars=names, var_name="feature", value_name="mean")
+    table["sd"] = wide.melt(id_vars=["run", "shot"], value_vars=[f"{n}_sd" for n in names])["value"].to_numpy()
+    return table.sort_values("run", kind="stable").reset_index(drop=True)

@@ -102,25 +102,16 @@ def print_cv(args) -> int:
 
 
 def predict(args) -> int:
-    import numpy as np
-    import pandas as pd
-
     from shockcal.config import load_config
     from shockcal.design import load_design
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
+    from shockcal.predict import emulator_predictions_long
 
     config = load_config(args.config)
     emulator = Emulator.load(args.emulator)
     design = load_design(args.design, config, columns=emulator.required_inputs(emulator.shots))
-    inputs = {k: design[k].to_numpy(float) for k in emulator.required_inputs(emulator.shots)}
-    mean, cov = emulator.predict(inputs, emulator.shots)
-    sd = np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
-    names = [(shot, feature) for shot in emulator.shots for feature in emulator.feature_names]
-    table = pd.DataFrame({"run": np.repeat(design["run"].to_numpy(), len(names)),
-                          "shot": np.tile([s for s, _ in names], len(design)),
-                          "feature": np.tile([f for _, f in names], len(design)),
-                          "mean": mean.ravel(), "sd": sd.ravel()})
+    table = emulator_predictions_long(emulator, design, emulator.shots)
     write_table(table, args.out, {"table": "emulator predictions", "design": args.design,
                                   "emulator": args.emulator, "units": {"mean": "m/s", "sd": "m/s"}})
     return 0
