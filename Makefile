@@ -6,7 +6,7 @@ INSTALLED := $(VENV)/.installed
 CORES ?= all
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick test test-slow test-slurm bench validate lint clean
+.PHONY: study quick check test test-slow test-slurm bench validate lint clean
 
 $(INSTALLED): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -22,6 +22,9 @@ study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
 	snakemake --cores $(CORES) --configfile config/quick.yaml all
 
+check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
+	snakemake --cores $(CORES) check
+
 test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 	$(VENV)/bin/pytest
 
@@ -31,13 +34,16 @@ test-slow: $(INSTALLED)  ## the slow checks only
 test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (root: installs slurm-wlm, munge)
 	tests/slurm/run_slurm_test.sh
 
-bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted)
+bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); installs the reference samplers
+	$(PY) -m pip install --quiet -e '.[test,bench]'
 	@for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 validate: $(INSTALLED)  ## our hydrocode + extractor against the paper's FLAG features and measured features
 	$(PY) benchmarks/validate_flag.py
 
-lint: $(INSTALLED)
+lint: $(INSTALLED)  ## ruff on the package, tests and benchmarks; snakemake's own lint of the rules
+	$(PY) -m pip install --quiet -e '.[test,lint]'
+	$(VENV)/bin/ruff check src tests benchmarks
 	snakemake --lint
 
 clean:

@@ -52,8 +52,9 @@ def test_gradient_of_the_hyperparameter_posterior(family):
     y = np.sin(4 * x[:, 0]) + 0.3 + 0.05 * rng.normal(size=30)
     phi = np.array([0.2, np.log(3.0), np.log(0.5), np.log(200.0)])
     for fit_mean in (False, True):
-        err = check_grad(lambda p: neg_log_posterior(p, x, y, family, 1e-8, fit_mean)[0],
-                         lambda p: neg_log_posterior(p, x, y, family, 1e-8, fit_mean)[1], phi)
+        args = (x, y, family, 1e-8, fit_mean)
+        err = check_grad(lambda p, a=args: neg_log_posterior(p, *a)[0], lambda p, a=args: neg_log_posterior(p, *a)[1],
+                         phi)
         assert err < 1e-4 * np.linalg.norm(neg_log_posterior(phi, x, y, family, 1e-8, fit_mean)[1]) + 1e-5
 
 

@@ -10,23 +10,23 @@ prior box. The emulator's hyperparameters are fixed at their fitted mode (modula
 docs/calibration.md). The sampled vector is (theta in native units, log lambda_y); the density
 includes the Jacobian of the log.
 
-Sampling (`shockcal.sampler`): an ensemble whose walkers start spread over the whole prior box,
-with mode-hopping moves, so every mode is populated from the start.
+Sampling (`shockcal.sampler`): adaptive sequential Monte Carlo from the prior, on the unit cube
+through `Problem.prior_transform`, with the batch log-likelihood `Problem.log_likelihood`.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from shockcal.diagnostics import RHAT_LIMIT, ess_bulk, ess_tail, split_rhat
 from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
 from shockcal.plausibility import check_observed_table
-from shockcal.sampler import run_ensemble
+from shockcal.sampler import smc_sample
 
 log = logging.getLogger("shockcal.calibration")
 LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
@@ -34,50 +34,88 @@ LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision 
 
 @dataclass
 class Problem:
-    """Everything the posterior density needs: emulator, shots, observed features, prior box."""
+    """Everything the posterior density needs: a predictive model, observed features, prior box.
 
-    emulator: object
-    shots: list[str]
-    observed: np.ndarray      # (F,) m/s, shot-major, emulator.feature_names order
+    `predict` maps theta (N, d) in native units to the predictive mean (N, F) and covariance
+    (N, F, F) of the features, m/s: any emulator (`PCGPEmulator.predict` from a notebook, or a
+    study's `Emulator` through `Problem.build`). Points are (theta, lambda_y). `prior_transform`
+    and `log_likelihood` are the pair a nested or SMC sampler takes (vectorised over a batch of
+    points); `log_posterior` is the same density for MCMC in (theta, log lambda_y).
+    """
+
+    predict: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+    observed: np.ndarray      # (F,) m/s
     obs_sd: np.ndarray        # (F,) m/s
-    names: list[str]          # calibrated design inputs, native units
+    names: list[str]          # calibrated inputs, native units
     lower: np.ndarray
     upper: np.ndarray
+    label: str = "calibration"
 
     @classmethod
     def build(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed"):
+        """The study's problem: the inputs `shots` need, their box, and their measured features."""
         names = emulator.required_inputs(shots)
         lower, upper = emulator.input_bounds(names)
         y = observed_vector(observed_table, shots, emulator.feature_names, source)
-        return cls(emulator, list(shots), y, sd_fraction * np.abs(y), names, lower, upper)
+
+        def predict(theta):
+            return emulator.predict(dict(zip(names, theta.T)), list(shots))
+
+        return cls(predict, y, sd_fraction * np.abs(y), names, np.asarray(lower), np.asarray(upper), "+".join(shots))
 
     @property
     def ndim(self) -> int:
         return len(self.names) + 1
 
-    def log_posterior(self, x: np.ndarray) -> np.ndarray:
-        """Log posterior (up to a constant) of walkers x (N, d + 1) = (theta, log lambda_y)."""
-        x = np.atleast_2d(x)
-        theta, log_lam = x[:, :-1], x[:, -1]
-        out = np.full(len(x), -np.inf)
-        inside = np.all((theta >= self.lower) & (theta <= self.upper), axis=1) & np.isfinite(log_lam)
-        if not inside.any():
-            return out
-        lam = np.exp(log_lam[inside])
-        mean, cov = self.emulator.predict(dict(zip(self.names, theta[inside].T)), self.shots)
-        cov = cov + (self.obs_sd**2)[None, :] * np.eye(len(self.observed))[None] / lam[:, None, None]
-        chol = np.linalg.cholesky(cov)
-        resid = np.linalg.solve(chol, (self.observed - mean)[..., None])[..., 0]
-        loglike = -0.5 * np.sum(resid**2, axis=1) - np.log(np.diagonal(chol, axis1=1, axis2=2)).sum(axis=1)
+    def prior_transform(self, u: np.ndarray) -> np.ndarray:
+        """Unit cube (N, d + 1) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5))."""
+        from scipy import stats
+
+        u = np.atleast_2d(u)
         shape, rate = LAMBDA_Y_PRIOR
-        out[inside] = loglike + shape * log_lam[inside] - rate * lam
+        theta = self.lower + u[:, :-1] * (self.upper - self.lower)
+        return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
+
+    def log_likelihood(self, points: np.ndarray) -> np.ndarray:
+        """Gaussian log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
+        inside the box, normalising constants included (so the evidence is a true marginal likelihood).
+        A non-finite value is an error naming the point: it means the emulator is broken there."""
+        points = np.atleast_2d(points)
+        theta, lam = points[:, :-1], points[:, -1]
+        mean, cov = self.predict(theta)
+        cov = cov + (self.obs_sd**2)[None, :] * np.eye(len(self.observed))[None] / lam[:, None, None]
+        value = _gaussian_log_density(self.observed - mean, cov)
+        bad = ~np.isfinite(value)
+        if bad.any():
+            point = dict(zip([*self.names, "lambda_y"], points[np.argmax(bad)].tolist()))
+            raise InputError(f"{self.label}: the log-likelihood is not finite at {point} "
+                             "(the emulator's prediction or covariance is invalid there)")
+        return value
+
+    def log_posterior(self, x: np.ndarray) -> np.ndarray:
+        """Log posterior (up to a constant) at x (N, d + 1) = (theta, log lambda_y); -inf outside the
+        box. The Gamma prior of lambda_y and the Jacobian of the log are included."""
+        x = np.atleast_2d(x)
+        out = np.full(len(x), -np.inf)
+        inside = np.all((x[:, :-1] >= self.lower) & (x[:, :-1] <= self.upper), axis=1) & np.isfinite(x[:, -1])
+        if inside.any():
+            log_lam = x[inside, -1]
+            shape, rate = LAMBDA_Y_PRIOR
+            points = np.column_stack([x[inside, :-1], np.exp(log_lam)])
+            out[inside] = self.log_likelihood(points) + shape * log_lam - rate * np.exp(log_lam)
         return out
 
-    def initial_walkers(self, n_walkers: int, rng: np.random.Generator) -> np.ndarray:
-        """Walkers spread uniformly over the box, lambda_y from its prior."""
-        theta = rng.uniform(self.lower, self.upper, size=(n_walkers, len(self.names)))
-        lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1], size=n_walkers)
-        return np.column_stack([theta, np.log(lam)])
+
+def _gaussian_log_density(resid: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """log N(resid; 0, cov) for a batch (N, F) and (N, F, F); NaN where cov is not positive definite."""
+    try:
+        chol = np.linalg.cholesky(cov)
+    except np.linalg.LinAlgError:      # locate the bad rows one by one
+        return np.array([_gaussian_log_density(r[None], c[None])[0] if np.all(np.linalg.eigvalsh(c) > 0)
+                         else np.nan for r, c in zip(resid, cov)])
+    z = np.linalg.solve(chol, resid[..., None])[..., 0]
+    log_det = 2.0 * np.log(np.diagonal(chol, axis1=1, axis2=2)).sum(axis=1)
+    return -0.5 * (np.sum(z**2, axis=1) + log_det + resid.shape[1] * np.log(2 * np.pi))
 
 
 def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> np.ndarray:
@@ -98,56 +136,55 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
     return np.concatenate(values)
 
 
-def sample(problem: Problem, n_samples: int, settings: dict, seed: int) -> tuple[pd.DataFrame, dict]:
-    """Run the ensemble; return retained samples (theta, lambda_y, log_post, chain, step) and run info."""
-    rng = np.random.default_rng(seed)
-    chains = run_ensemble(problem.log_posterior, problem.initial_walkers(settings["walkers"], rng), n_samples,
-                          settings["burn_in_steps"], settings["thin"], settings["mode_hop_fraction"], seed,
-                          bounds=(problem.lower, problem.upper))
-    walkers, steps, ndim = chains.samples.shape
-    frame = pd.DataFrame(chains.samples.reshape(-1, ndim), columns=[*problem.names, "log_lambda_y"])
-    frame["lambda_y"] = np.exp(frame.pop("log_lambda_y"))
-    frame["log_post"] = chains.log_prob.reshape(-1)
-    frame["chain"] = np.repeat(np.arange(walkers), steps)
-    frame["step"] = np.tile(chains.steps, walkers)
-    info = {"acceptance": chains.acceptance, "walkers": walkers, "burn_in_steps": settings["burn_in_steps"],
-            "thin": settings["thin"], "retained": len(frame), "seed": seed}
-    return frame, info
+@dataclass(frozen=True)
+class SamplerSettings:
+    """Adaptive SMC: particles (the posterior draws returned), Metropolis moves per particle at each
+    temperature, and the seed."""
+
+    particles: int
+    mcmc_steps: int
+    seed: int
 
 
-def summarize(samples: pd.DataFrame, names: list[str], units: dict) -> pd.DataFrame:
-    """Per parameter: mean, sd, 5/50/95% quantiles, split R-hat, bulk/tail ESS, and a mixing flag."""
+def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood), their summary, and
+    run info (evidence, likelihood evaluations, temperatures, distinct draws)."""
+    draws = smc_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.particles,
+                       settings.mcmc_steps, settings.seed)
+    frame = pd.DataFrame(draws.points, columns=[*problem.names, "lambda_y"])
+    frame["log_likelihood"] = draws.log_likelihood
+    info = {"sampler": "smcpy adaptive SMC", "particles": settings.particles, "mcmc_steps": settings.mcmc_steps,
+            "seed": settings.seed, "log_evidence": draws.log_evidence, "likelihood_evaluations": draws.n_likelihood,
+            "temperatures": draws.temperatures, "retained": len(frame),
+            "distinct_draws": int(len(np.unique(draws.points, axis=0)))}
+    return frame, summarize(frame, [*problem.names, "lambda_y"]), info
+
+
+def summarize(samples: pd.DataFrame, names: list[str]) -> pd.DataFrame:
+    """Per parameter: mean, sd, 5/50/95% quantiles and the number of distinct draws."""
     rows = []
-    n_chains = samples["chain"].nunique()
-    for name in [*names, "lambda_y"]:
-        draws = samples[name].to_numpy().reshape(n_chains, -1)
-        q05, q50, q95 = np.quantile(draws, [0.05, 0.5, 0.95])
-        rhat = split_rhat(draws)
-        rows.append({"parameter": name, "unit": units.get(name, "-"), "mean": draws.mean(), "sd": draws.std(ddof=1),
-                     "q05": q05, "q50": q50, "q95": q95, "r_hat": rhat, "ess_bulk": ess_bulk(draws),
-                     "ess_tail": ess_tail(draws), "converged": bool(rhat <= RHAT_LIMIT)})
-    summary = pd.DataFrame(rows)
-    for row in summary[~summary["converged"]].itertuples():
-        log.warning("parameter %s: R-hat %.3f > %.2f: the chains have not mixed; increase calibration.burn_in_steps "
-                    "or n_samples, or calibration.walkers", row.parameter, row.r_hat, RHAT_LIMIT)
-    return summary
+    for name in names:
+        x = samples[name].to_numpy()
+        q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
+        rows.append({"parameter": name, "mean": x.mean(), "sd": x.std(ddof=1), "q05": q05, "q50": q50, "q95": q95,
+                     "distinct": len(np.unique(x))})
+    return pd.DataFrame(rows)
 
 
 def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str = "observed",
               **overrides) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Calibrate `shots` jointly (one shot = single-shot calibration): samples, summary, run info.
 
-    `overrides` replace keys of config["calibration"] (e.g. n_samples, burn_in_steps, seed).
+    `overrides` replace keys of config["calibration"] (particles, mcmc_steps, seed).
     """
-    settings = {**config["calibration"], **overrides}
     problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"], source)
     check_observed_table(observed, shots, source, config["checks"]["observed_units"])
-    n_samples = settings.get("n_samples") or settings["n_samples_single" if len(shots) == 1 else "n_samples_joint"]
-    seed = settings.get("seed", config["study"]["seed"] + settings["seed_offset"])
-    samples, info = sample(problem, n_samples, settings, seed)
-    units = {k: config["inputs"][k]["unit"] for k in problem.names}
-    summary = summarize(samples, problem.names, units)
-    info.update(shots=list(shots), parameters=problem.names, units={**units, "lambda_y": "-"},
+    calibration = {**config["calibration"], **{k: v for k, v in overrides.items() if v is not None}}
+    seed = calibration.get("seed", config["study"]["seed"] + calibration["seed_offset"])
+    samples, summary, info = sample(problem, SamplerSettings(calibration["particles"], calibration["mcmc_steps"], seed))
+    units = {**{k: config["inputs"][k]["unit"] for k in problem.names}, "lambda_y": "-"}
+    summary.insert(1, "unit", summary["parameter"].map(units))
+    info.update(shots=list(shots), parameters=problem.names, units=units,
                 observed=problem.observed.tolist(), observed_sd_m_s=problem.obs_sd.tolist())
     return samples, summary, info
 
@@ -160,7 +197,7 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truth
     `truths` is given, from hydrocode runs (`HydroTruths`: theta of each run and its extracted
     features). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is added and
     the features are calibrated (`overrides` as in `calibrate`). Columns: trial, parameter, truth,
-    q05, q95, inside (the 90% interval holds the truth), r_hat.
+    q05, q95, inside (the 90% interval holds the truth), distinct (distinct posterior draws).
     """
     rng = np.random.default_rng(seed)
     names = emulator.required_inputs(shots)
@@ -176,7 +213,7 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truth
         for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
             q05, q95 = summary.loc[name, ["q05", "q95"]]
             rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= truth <= q95), "r_hat": summary.loc[name, "r_hat"]})
+                         "inside": bool(q05 <= truth <= q95), "distinct": summary.loc[name, "distinct"]})
         log.info("synthetic trial %d/%d done", trial + 1, trials)
     return pd.DataFrame(rows)
 
@@ -225,9 +262,17 @@ class HydroTruths:
 
 
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
-    """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), largest R-hat."""
-    return trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
-                                                       max_r_hat=("r_hat", "max")).reset_index()
+    """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), the central 95%
+    binomial band of that share for a calibrated method (band_low, band_high), whether it lies in the
+    band, and the fewest distinct posterior draws of any trial."""
+    from scipy import stats
+
+    table = trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
+                                                        min_distinct=("distinct", "min")).reset_index()
+    table["band_low"] = stats.binom.ppf(0.025, table["trials"], 0.9) / table["trials"]
+    table["band_high"] = stats.binom.ppf(0.975, table["trials"], 0.9) / table["trials"]
+    table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
+    return table
 
 
 def coverage_check(emulator, shots, config: dict, trials: int | None = None,
@@ -237,5 +282,5 @@ def coverage_check(emulator, shots, config: dict, trials: int | None = None,
     settings, check = config["calibration"], config["calibration"]["check"]
     table = synthetic_truth(emulator, shots, config, trials or check["trials"],
                             seed=config["study"]["seed"] + settings["seed_offset"] + 1, truths=truths,
-                            n_samples=check["n_samples"], burn_in_steps=check["burn_in_steps"])
+                            particles=check["particles"], mcmc_steps=check["mcmc_steps"])
     return table, coverage_table(table)

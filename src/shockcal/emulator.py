@@ -71,7 +71,7 @@ class InputMap:
                 "strain": self.strain}
 
     @classmethod
-    def from_json(cls, d: dict) -> "InputMap":
+    def from_json(cls, d: dict) -> InputMap:
         return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]), d["strain"])
 
 
@@ -119,7 +119,7 @@ class Settings:
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
 
     @classmethod
-    def from_config(cls, settings: dict, seed: int) -> "Settings":
+    def from_config(cls, settings: dict, seed: int) -> Settings:
         keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
 
@@ -170,7 +170,7 @@ class PCGPEmulator:
         return (np.asarray(X, dtype=float) - self.lower) / (self.upper - self.lower)
 
     @classmethod
-    def fit(cls, X, Y, lower, upper, settings: Settings | None = None) -> "PCGPEmulator":
+    def fit(cls, X, Y, lower, upper, settings: Settings | None = None) -> PCGPEmulator:
         """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode.
 
         With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
@@ -185,7 +185,7 @@ class PCGPEmulator:
         return model
 
     @classmethod
-    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets) -> list["PCGPEmulator"]:
+    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets) -> list[PCGPEmulator]:
         """One emulator per set of training rows, all GP fits in one (parallel) batch."""
         X, Y = np.asarray(X, dtype=float), np.asarray(Y, dtype=float)
         x_all = (X - np.asarray(lower, dtype=float)) / (np.asarray(upper, dtype=float) - np.asarray(lower, dtype=float))
@@ -299,7 +299,7 @@ class PCGPEmulator:
                                      "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
 
     @classmethod
-    def from_saved(cls, meta: dict, arrays, prefix: str = "") -> "PCGPEmulator":
+    def from_saved(cls, meta: dict, arrays, prefix: str = "") -> PCGPEmulator:
         hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
         return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
@@ -313,7 +313,7 @@ class PCGPEmulator:
         return path
 
     @classmethod
-    def load(cls, path) -> "PCGPEmulator":
+    def load(cls, path) -> PCGPEmulator:
         with np.load(path) as npz:
             arrays = dict(npz)
         header = json.loads(str(arrays.pop("header")))
@@ -419,8 +419,12 @@ class Emulator:
         k = len(self.feature_names)
         parts = []
         for block in self.blocks:
-            held = {"loo_closed_form": block.model.loo, "kfold": lambda: block.model.cross_validate(folds),
-                    "outer": lambda: block.model.outer_check(margin, np.arange(len(block.input_map.terms)))}[scheme]()
+            if scheme == "loo_closed_form":
+                held = block.model.loo()
+            elif scheme == "kfold":
+                held = block.model.cross_validate(folds)
+            else:
+                held = block.model.outer_check(margin, np.arange(len(block.input_map.terms)))
             for i, shot in enumerate(block.shots):
                 for f, feature in enumerate(self.feature_names):
                     col = k * i + f
@@ -448,7 +452,7 @@ class Emulator:
         return directory
 
     @classmethod
-    def load(cls, directory) -> "Emulator":
+    def load(cls, directory) -> Emulator:
         """Read a saved emulator, refusing other formats and versions with a clear message."""
         directory = Path(directory)
         meta_path = directory / "emulator.json"

@@ -35,9 +35,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import optimize, stats
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
@@ -70,7 +74,7 @@ class Mixture:
         lo, hi = (self.means - 10 * self.sds).min(), (self.means + 10 * self.sds).max()
         return optimize.brentq(lambda x: self.cdf(x)[0] - p, lo, hi, xtol=1e-9)
 
-    def subset(self, mask) -> "Mixture":
+    def subset(self, mask) -> Mixture:
         w = self.weights[mask]
         return Mixture(w / w.sum(), self.means[mask], self.sds[mask])
 
@@ -172,7 +176,7 @@ def extract_features(t, v, analysis: dict, settings: dict) -> dict:
                    settings["n_components"], settings["n_samples"]).features
 
 
-def features_table(traces, config: dict, shot: str) -> "pd.DataFrame":
+def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
     """One row per simulated run: run, status, reason and the ten features.
 
     Failed simulations keep their status and reason; a trace the extractor cannot read becomes

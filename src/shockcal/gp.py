@@ -65,7 +65,7 @@ class Hyper:
     mean: float = 0.0
 
     @classmethod
-    def unpack(cls, phi: np.ndarray, mean: float = 0.0) -> "Hyper":
+    def unpack(cls, phi: np.ndarray, mean: float = 0.0) -> Hyper:
         return cls(float(np.exp(phi[0])), np.exp(phi[1:-1]), float(np.exp(phi[-1])), float(mean))
 
 
@@ -152,7 +152,7 @@ class GaussianProcess:
 
     @classmethod
     def fit(cls, x, y, n_starts: int = 4, seed: int = 0, jitter: float = 1e-8, fit_rows=None,
-            family: str = "gaussian", fit_mean: bool = False) -> "GaussianProcess":
+            family: str = "gaussian", fit_mean: bool = False) -> GaussianProcess:
         """MAP hyperparameters (L-BFGS-B from several starts), then condition on all of (x, y).
 
         `fit_rows` restricts the hyperparameter fit to a subset of rows (for speed on large

@@ -21,7 +21,6 @@ import argparse
 import json
 import os
 import re
-import shutil
 import signal
 import statistics
 import subprocess
@@ -49,7 +48,7 @@ def loadavg() -> str:
     return Path("/proc/loadavg").read_text().split(" ", 3)[:3].__str__()
 
 
-ACTIVE: list["Run"] = []
+ACTIVE: list[Run] = []
 
 
 class Run:
@@ -76,10 +75,10 @@ class Run:
     def wait(self, timeout: float = RUN_TIMEOUT_S) -> int:
         try:
             self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
+        except subprocess.TimeoutExpired as err:
             log(f"snakemake still running after {timeout:.0f} s: a hang; stopping it (pid {self.proc.pid})")
             self.stop()
-            raise SystemExit(f"FAIL: hang (see {self.logfile})")
+            raise SystemExit(f"FAIL: hang (see {self.logfile})") from err
         self.reader.join(timeout=10)
         self.elapsed = time.time() - self.t0
         return self.proc.returncode

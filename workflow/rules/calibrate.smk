@@ -1,4 +1,4 @@
-# Calibrate: single-shot posteriors, the joint posterior, and the synthetic-truth coverage check.
+# Calibrate: single-shot posteriors, the joint posterior, and (target `check`) the synthetic-truth coverage checks.
 
 CALIBRATIONS = [*SHOTS, "joint"]
 
@@ -77,4 +77,11 @@ rule calibration_check_hydrocode:
 
 
 ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)
-ALL_TARGETS += [f"{RESULTS}/posterior/coverage.parquet", f"{RESULTS}/posterior/coverage_hydrocode.parquet"]
+CHECK_TARGETS = [f"{RESULTS}/posterior/coverage.parquet", f"{RESULTS}/posterior/coverage_hydrocode.parquet"]
+
+
+rule check:
+    """The synthetic-truth coverage checks (calibration.check.trials each, emulator and hydrocode
+    truth): `make check`, outside the default study because of their cost (README)."""
+    input:
+        CHECK_TARGETS,

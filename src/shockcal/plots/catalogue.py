@@ -12,11 +12,15 @@ figure shows a "no data" note; a given file that is missing or unreadable is an 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import Callable
+from typing import TYPE_CHECKING
 
 from shockcal.errors import InputError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 class FigureInputs:

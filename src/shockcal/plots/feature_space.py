@@ -12,8 +12,16 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from shockcal.plots.style import (CALIBRATION_FEATURES, COLORS, feature_label, figure_legend, no_data, note, styled,
-                                  subplots)
+from shockcal.plots.style import (
+    CALIBRATION_FEATURES,
+    COLORS,
+    feature_label,
+    figure_legend,
+    no_data,
+    note,
+    styled,
+    subplots,
+)
 
 
 def usable(features: pd.DataFrame | None) -> pd.DataFrame | None:

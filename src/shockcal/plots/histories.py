@@ -14,8 +14,7 @@ from matplotlib import patheffects
 
 from shockcal.plots.feature_space import usable
 from shockcal.plots.records import plot_feature_points
-from shockcal.plots.style import (COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, figure_legend, no_data, styled,
-                                  subplots)
+from shockcal.plots.style import COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, figure_legend, no_data, styled, subplots
 
 TIME_COLUMNS = tuple(f"t_{key}" for key in FEATURES)
 

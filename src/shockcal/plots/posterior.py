@@ -1,7 +1,7 @@
 """Posterior figures: 7 (marginals per calibration, rows, with Gray et al.'s sets) and 8 (joint pairs).
 
 Posterior tables hold one column per calibrated input in Table IV units (plus bookkeeping columns
-such as lambda_y, log_post, chain, which are ignored). Axes span the prior box in display units,
+such as lambda_y and log_likelihood, which are ignored). Axes span the prior box in display units,
 widened where a reference value lies outside it.
 """
 

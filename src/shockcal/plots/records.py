@@ -10,8 +10,17 @@ from __future__ import annotations
 import pandas as pd
 
 from shockcal.plots.feature_space import observed_row
-from shockcal.plots.style import (COLORS, FEATURES, TIME_LABEL, VELOCITY_LABEL, figure_legend, no_data, note, styled,
-                                  subplots)
+from shockcal.plots.style import (
+    COLORS,
+    FEATURES,
+    TIME_LABEL,
+    VELOCITY_LABEL,
+    figure_legend,
+    no_data,
+    note,
+    styled,
+    subplots,
+)
 
 
 def plot_feature_points(ax, measured: pd.Series, dt: float = 0.0, label: str = "measured features") -> None:
