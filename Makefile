@@ -17,6 +17,7 @@ $(INSTALLED): pyproject.toml
 study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report
 	snakemake --cores $(CORES) all
 	snakemake --report results/report.html all
+	shockcal stage-times --benchmarks results/benchmarks
 	@echo "report: $(CURDIR)/results/report.html"
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick

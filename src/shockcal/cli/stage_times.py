@@ -1,0 +1,21 @@
+"""`shockcal stage-times`: where a study's time went, per stage (Snakemake benchmark files)."""
+
+from __future__ import annotations
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("stage-times", help="wall and CPU seconds per workflow stage of a finished study")
+    p.add_argument("--benchmarks", default="results/benchmarks", help="the study's benchmark folder")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from shockcal.errors import InputError
+    from shockcal.stage_times import stage_table
+
+    if not Path(args.benchmarks).is_dir():
+        raise InputError(f"{args.benchmarks}: no such folder (run the study first)")
+    print(stage_table(Path(args.benchmarks)).to_string(index=False))
+    return 0
