@@ -65,7 +65,7 @@ def mid_box(emulator, shots) -> dict:
 
 @pytest.fixture
 def small_config(paper_config):
-    paper_config["calibration"].update(particles=1000, mcmc_steps=5)
+    paper_config["calibration"].update(n_live=200, n_eff=500, draws=2000)
     return paper_config
 
 
@@ -94,14 +94,32 @@ def test_shot_without_emulator_is_rejected(small_config):
         calibrate(emu, ["106S"], obs, small_config, n_samples=100)
 
 
-def test_synthetic_truth_coverage_is_near_nominal(small_config):
-    # A two-input shot keeps 100 seeded trials fast; the 9-input version is a slow test below.
+def test_synthetic_truth_table_and_binomial_band(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
-    trials = synthetic_truth(emu, ["toy"], small_config, trials=100, seed=4, particles=500, mcmc_steps=3)
+    trials = synthetic_truth(emu, ["toy"], small_config, trials=3, seed=4, n_live=100, n_eff=300)
+    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess"]
+    assert len(trials) == 3 * 3 and (trials["q05"] < trials["q95"]).all() and (trials["ess"] >= 300).all()
+    table = coverage_table(pd.concat([trials] * 34, ignore_index=True).assign(trial=np.repeat(np.arange(102), 3)))
+    # 102 trials, nominal 0.9: the central 95% binomial band is 0.843-0.951
+    assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
+
+
+@pytest.mark.slow
+def test_synthetic_truth_coverage_is_near_nominal(small_config):
+    # A two-input shot and 40 trials (about 5 min: nautilus costs a few seconds per run even on a toy).
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    trials = synthetic_truth(emu, ["toy"], small_config, trials=40, seed=4, n_live=100, n_eff=300)
     table = coverage_table(trials)
-    assert (table["trials"] == 100).all(), table
+    assert (table["trials"] == 40).all(), table
+    assert table["within_band"].all() and table["band_low"].iloc[0] == pytest.approx(0.8), table
+    assert 0.84 <= trials["inside"].mean() <= 0.96, table
+
+
+@pytest.mark.slow
+def test_synthetic_truth_coverage_hundred_trials_within_the_binomial_band(small_config):
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    table = coverage_table(synthetic_truth(emu, ["toy"], small_config, trials=100, seed=4, n_live=100, n_eff=300))
     assert table["within_band"].all() and table["band_low"].iloc[0] == pytest.approx(0.84), table
-    assert 0.86 <= trials["inside"].mean() <= 0.94, table
 
 
 def _toy_hydro_truths(emu, config, n_runs=60):
@@ -128,19 +146,20 @@ def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
     assert draws[0][1].shape == (4,)
 
 
+@pytest.mark.slow
 def test_hydro_truth_coverage_is_near_nominal(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
     truths, _ = _toy_hydro_truths(emu, small_config)
-    trials = synthetic_truth(emu, ["toy"], small_config, trials=50, seed=5, truths=truths, particles=500,
-                             mcmc_steps=3)
-    assert trials["trial"].nunique() == 50
+    trials = synthetic_truth(emu, ["toy"], small_config, trials=40, seed=5, truths=truths, n_live=100,
+                             n_eff=300)
+    assert trials["trial"].nunique() == 40
     assert 0.84 <= trials["inside"].mean() <= 0.96, coverage_table(trials)
 
 
 @pytest.mark.slow
 def test_synthetic_truth_coverage_eight_inputs(small_config):
     emu = ShotEmulator(small_config, shots=["105S"], emulator_sd=0.3)
-    trials = synthetic_truth(emu, ["105S"], small_config, trials=100, seed=4, particles=2000, mcmc_steps=5)
+    trials = synthetic_truth(emu, ["105S"], small_config, trials=100, seed=4, n_live=500, n_eff=1000)
     table = coverage_table(trials)
     print(table.to_string())
     assert table["within_band"].all(), table
@@ -153,7 +172,7 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     from shockcal.cli import main
     from shockcal.io import read_table_metadata
 
-    small_config["calibration"]["particles"] = 1000
+    small_config["calibration"]["draws"] = 1000
     config_path = tmp_path / "config.yaml"
     config_path.write_text(yaml.safe_dump(small_config))
     emu = ShotEmulator(small_config)

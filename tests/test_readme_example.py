@@ -17,4 +17,4 @@ def test_readme_notebook_example_recovers_the_inputs_that_made_the_measurement()
     for name, truth in {"a": 0.4, "b": 0.5}.items():
         assert summary.loc[name, "q05"] < truth < summary.loc[name, "q95"], summary
     assert summary.loc["a", "q95"] - summary.loc["a", "q05"] < 0.25     # the data do inform a
-    assert len(scope["draws"]) == 2000 and scope["info"]["likelihood_evaluations"] > 2000
+    assert len(scope["draws"]) == 10000 and scope["info"]["ess_kish"] >= 1500

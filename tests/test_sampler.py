@@ -1,10 +1,11 @@
-"""The SMC sampler on toys with known posteriors: a correlated Gaussian and two separated modes."""
+"""The nested sampler on toys with known posteriors: a correlated Gaussian and two separated modes."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from shockcal.sampler import smc_sample
+from shockcal.sampler import WeightedDraws, nested_sample
 
 
 def _box_transform(lower, upper):
@@ -26,15 +27,17 @@ def test_linear_gaussian_posterior_mean_covariance_and_evidence():
         r = y[None, :] - theta @ x.T
         return -0.5 * np.sum(r**2, axis=1) / 0.3**2 - 20 * np.log(0.3 * np.sqrt(2 * np.pi))
 
-    draws = smc_sample(_box_transform(lower, upper), log_likelihood, 3, n_particles=4000, n_mcmc_steps=5, seed=3)
+    draws = nested_sample(_box_transform(lower, upper), log_likelihood, 3, n_live=300, n_eff=1500, seed=3)
     sd = np.sqrt(np.diag(post_cov))
-    # 4000 draws with an ESS of at least 1000: the mean is within 4 sd/sqrt(1000)
-    np.testing.assert_array_less(np.abs(draws.points.mean(axis=0) - post_mean), 4 * sd / np.sqrt(1000))
-    np.testing.assert_allclose(np.cov(draws.points.T), post_cov, rtol=0.15, atol=0.15 * sd.max() ** 2)
+    assert draws.kish_ess() >= 1500
+    mean = draws.weights @ draws.points
+    np.testing.assert_array_less(np.abs(mean - post_mean), 4 * sd / np.sqrt(1500))
+    cov = np.cov(draws.points.T, aweights=draws.weights)
+    np.testing.assert_allclose(cov, post_cov, rtol=0.15, atol=0.15 * sd.max() ** 2)
     log_z = (log_likelihood(post_mean[None])[0] + 0.5 * np.linalg.slogdet(2 * np.pi * post_cov)[1]
              - np.log(np.prod(upper - lower)))
     assert abs(draws.log_evidence - log_z) < 0.3
-    assert draws.n_likelihood > 4000 and draws.temperatures >= 2
+    assert draws.n_likelihood > 2000
 
 
 def test_two_modes_found_in_the_right_proportion():
@@ -45,10 +48,10 @@ def test_two_modes_found_in_the_right_proportion():
         return np.logaddexp(a, b) - 0.5 * theta[:, 1] ** 2
 
     transform = _box_transform(np.array([-6.0, -5.0]), np.array([6.0, 5.0]))
-    draws = smc_sample(transform, log_likelihood, 2, n_particles=4000, n_mcmc_steps=5, seed=5)
+    draws = nested_sample(transform, log_likelihood, 2, n_live=300, n_eff=1500, seed=5)
     upper = draws.points[:, 0] > 0
-    assert abs(upper.mean() - 0.7) < 0.04
-    assert abs(np.median(np.abs(draws.points[:, 0])) - 3.0) < 0.1
+    assert abs(draws.weights[upper].sum() - 0.7) < 0.04
+    assert abs(draws.weights @ np.abs(draws.points[:, 0]) - 3.0) < 0.1
 
 
 def test_same_seed_gives_identical_draws():
@@ -56,7 +59,15 @@ def test_same_seed_gives_identical_draws():
         return -0.5 * np.sum((theta - 0.3) ** 2, axis=1) / 0.01
 
     transform = _box_transform(np.zeros(2), np.ones(2))
-    a = smc_sample(transform, log_likelihood, 2, n_particles=500, n_mcmc_steps=2, seed=1)
-    b = smc_sample(transform, log_likelihood, 2, n_particles=500, n_mcmc_steps=2, seed=1)
+    a = nested_sample(transform, log_likelihood, 2, n_live=100, n_eff=200, seed=1)
+    b = nested_sample(transform, log_likelihood, 2, n_live=100, n_eff=200, seed=1)
     np.testing.assert_array_equal(a.points, b.points)
     assert a.log_evidence == b.log_evidence
+
+
+def test_systematic_resampling_keeps_each_point_floor_or_ceil_of_its_share():
+    w = np.array([0.5, 0.3, 0.15, 0.05])
+    draws = WeightedDraws(np.arange(4.0)[:, None], np.log(w), np.zeros(4), 0.0, 4)
+    counts = np.bincount(draws.resample(1000, np.random.default_rng(0)), minlength=4)
+    assert counts.sum() == 1000 and np.all(np.abs(counts - 1000 * w) < 1)
+    assert draws.kish_ess() == pytest.approx(1 / np.sum(w**2))

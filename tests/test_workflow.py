@@ -94,7 +94,7 @@ def test_study_products(study):
         usable = ok if usable is None else usable & ok
     for name in ("104S", "105S", "106S", "joint"):
         summary = pd.read_parquet(results / "posterior" / f"{name}_summary.parquet")
-        assert {"mean", "sd", "q05", "q95", "distinct"} <= set(summary.columns), summary.columns
+        assert {"mean", "sd", "q05", "q95", "ess"} <= set(summary.columns), summary.columns
     cv = pd.read_parquet(results / "emulator" / "cv.parquet")
     assert len(cv) == len(usable) * 12                        # failed runs are excluded, not lost
 
@@ -112,7 +112,7 @@ def test_nothing_to_redo(study):
 
 
 def test_sampler_setting_reruns_no_simulation(study, tmp_path):
-    jobs = pending_jobs(study[1], overlay(tmp_path / "sampler.yaml", calibration={"particles": 1200}))
+    jobs = pending_jobs(study[1], overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
     assert jobs.get("calibrate") == 4
     assert not {"design", "simulate", "features", "emulator"} & set(jobs), jobs
 

@@ -10,8 +10,8 @@ prior box. The emulator's hyperparameters are fixed at their fitted mode (modula
 docs/calibration.md). The sampled vector is (theta in native units, log lambda_y); the density
 includes the Jacobian of the log.
 
-Sampling (`shockcal.sampler`): adaptive sequential Monte Carlo from the prior, on the unit cube
-through `Problem.prior_transform`, with the batch log-likelihood `Problem.log_likelihood`.
+Sampling (`shockcal.sampler`): importance nested sampling (nautilus) from the unit cube through
+`Problem.prior_transform`, with the batch log-likelihood `Problem.log_likelihood`.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import pandas as pd
 from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
 from shockcal.plausibility import check_observed_table
-from shockcal.sampler import smc_sample
+from shockcal.sampler import WeightedDraws, nested_sample
 
 log = logging.getLogger("shockcal.calibration")
 LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
@@ -138,50 +138,63 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
 
 @dataclass(frozen=True)
 class SamplerSettings:
-    """Adaptive SMC: particles (the posterior draws returned), Metropolis moves per particle at each
-    temperature, and the seed."""
+    """nautilus: live points, the effective sample size (Kish) to reach, the number of equal-weight
+    draws written, and the seed."""
 
-    particles: int
-    mcmc_steps: int
-    seed: int
+    n_live: int = 1000
+    n_eff: int = 3000
+    draws: int = 10000
+    seed: int = 0
 
 
 def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
-    """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood), their summary, and
-    run info (evidence, likelihood evaluations, temperatures, distinct draws)."""
-    draws = smc_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.particles,
-                       settings.mcmc_steps, settings.seed)
-    frame = pd.DataFrame(draws.points, columns=[*problem.names, "lambda_y"])
-    frame["log_likelihood"] = draws.log_likelihood
-    info = {"sampler": "smcpy adaptive SMC", "particles": settings.particles, "mcmc_steps": settings.mcmc_steps,
-            "seed": settings.seed, "log_evidence": draws.log_evidence, "likelihood_evaluations": draws.n_likelihood,
-            "temperatures": draws.temperatures, "retained": len(frame),
-            "distinct_draws": int(len(np.unique(draws.points, axis=0)))}
-    return frame, summarize(frame, [*problem.names, "lambda_y"]), info
+    """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood) resampled from the
+    weighted ones, the summary of the weighted draws, and run info (evidence, likelihood
+    evaluations, Kish ESS, distinct draws)."""
+    weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
+                             settings.n_eff, settings.seed)
+    rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
+    frame = pd.DataFrame(weighted.points[rows], columns=[*problem.names, "lambda_y"])
+    frame["log_likelihood"] = weighted.log_likelihood[rows]
+    info = {"sampler": "nautilus", "n_live": settings.n_live, "n_eff_target": settings.n_eff, "seed": settings.seed,
+            "log_evidence": weighted.log_evidence, "likelihood_evaluations": weighted.n_likelihood,
+            "weighted_draws": len(weighted.points), "ess_kish": weighted.kish_ess(), "retained": len(frame),
+            "distinct_draws": int(len(np.unique(rows)))}
+    return frame, summarize(weighted, [*problem.names, "lambda_y"]), info
 
 
-def summarize(samples: pd.DataFrame, names: list[str]) -> pd.DataFrame:
-    """Per parameter: mean, sd, 5/50/95% quantiles and the number of distinct draws."""
+def summarize(draws: WeightedDraws, names: list[str]) -> pd.DataFrame:
+    """Per parameter: weighted mean, sd, 5/50/95% quantiles, and the Kish ESS of the weights."""
+    w = draws.weights
     rows = []
-    for name in names:
-        x = samples[name].to_numpy()
-        q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
-        rows.append({"parameter": name, "mean": x.mean(), "sd": x.std(ddof=1), "q05": q05, "q50": q50, "q95": q95,
-                     "distinct": len(np.unique(x))})
+    for j, name in enumerate(names):
+        x = draws.points[:, j]
+        mean = float(np.sum(w * x))
+        q05, q50, q95 = weighted_quantiles(x, w, [0.05, 0.5, 0.95])
+        rows.append({"parameter": name, "mean": mean, "sd": float(np.sqrt(np.sum(w * (x - mean) ** 2))),
+                     "q05": q05, "q50": q50, "q95": q95, "ess": draws.kish_ess()})
     return pd.DataFrame(rows)
+
+
+def weighted_quantiles(x: np.ndarray, w: np.ndarray, q) -> np.ndarray:
+    """Quantiles of weighted draws: the inverse of the midpoint-interpolated weighted CDF."""
+    order = np.argsort(x)
+    cdf = np.cumsum(w[order]) - 0.5 * w[order]
+    return np.interp(q, cdf / w.sum(), x[order])
 
 
 def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str = "observed",
               **overrides) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Calibrate `shots` jointly (one shot = single-shot calibration): samples, summary, run info.
 
-    `overrides` replace keys of config["calibration"] (particles, mcmc_steps, seed).
+    `overrides` replace keys of config["calibration"] (n_live, n_eff, draws, seed).
     """
     problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"], source)
     check_observed_table(observed, shots, source, config["checks"]["observed_units"])
     calibration = {**config["calibration"], **{k: v for k, v in overrides.items() if v is not None}}
     seed = calibration.get("seed", config["study"]["seed"] + calibration["seed_offset"])
-    samples, summary, info = sample(problem, SamplerSettings(calibration["particles"], calibration["mcmc_steps"], seed))
+    settings = SamplerSettings(calibration["n_live"], calibration["n_eff"], calibration["draws"], seed)
+    samples, summary, info = sample(problem, settings)
     units = {**{k: config["inputs"][k]["unit"] for k in problem.names}, "lambda_y": "-"}
     summary.insert(1, "unit", summary["parameter"].map(units))
     info.update(shots=list(shots), parameters=problem.names, units=units,
@@ -197,7 +210,7 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truth
     `truths` is given, from hydrocode runs (`HydroTruths`: theta of each run and its extracted
     features). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is added and
     the features are calibrated (`overrides` as in `calibrate`). Columns: trial, parameter, truth,
-    q05, q95, inside (the 90% interval holds the truth), distinct (distinct posterior draws).
+    q05, q95, inside (the 90% interval holds the truth), ess (the trial's Kish ESS).
     """
     rng = np.random.default_rng(seed)
     names = emulator.required_inputs(shots)
@@ -213,7 +226,7 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truth
         for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
             q05, q95 = summary.loc[name, ["q05", "q95"]]
             rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= truth <= q95), "distinct": summary.loc[name, "distinct"]})
+                         "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"]})
         log.info("synthetic trial %d/%d done", trial + 1, trials)
     return pd.DataFrame(rows)
 
@@ -264,11 +277,11 @@ class HydroTruths:
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), the central 95%
     binomial band of that share for a calibrated method (band_low, band_high), whether it lies in the
-    band, and the fewest distinct posterior draws of any trial."""
+    band, and the smallest Kish ESS of any trial."""
     from scipy import stats
 
     table = trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
-                                                        min_distinct=("distinct", "min")).reset_index()
+                                                        min_ess=("ess", "min")).reset_index()
     table["band_low"] = stats.binom.ppf(0.025, table["trials"], 0.9) / table["trials"]
     table["band_high"] = stats.binom.ppf(0.975, table["trials"], 0.9) / table["trials"]
     table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
@@ -282,5 +295,5 @@ def coverage_check(emulator, shots, config: dict, trials: int | None = None,
     settings, check = config["calibration"], config["calibration"]["check"]
     table = synthetic_truth(emulator, shots, config, trials or check["trials"],
                             seed=config["study"]["seed"] + settings["seed_offset"] + 1, truths=truths,
-                            particles=check["particles"], mcmc_steps=check["mcmc_steps"])
+                            n_live=check["n_live"], n_eff=check["n_eff"], draws=check["n_eff"])
     return table, coverage_table(table)

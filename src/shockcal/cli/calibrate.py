@@ -6,13 +6,13 @@ from shockcal.cli import add_config_argument, parse_pairs
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("calibrate", help="posterior of the inputs given measured features (adaptive SMC)")
+    p = subparsers.add_parser("calibrate", help="posterior of the inputs given measured features (nested sampling)")
     add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
     p.add_argument("--observed", required=True, help="observed features table (CSV or Parquet: shot + feature columns)")
     p.add_argument("--out", required=True, help="posterior samples (Parquet); the summary goes beside it as *_summary.parquet")
-    p.add_argument("--particles", type=int, help="override calibration.particles (the number of posterior draws)")
+    p.add_argument("--n-eff", type=int, help="override calibration.n_eff (effective sample size to reach)")
     p.set_defaults(func=run)
 
     c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
@@ -46,14 +46,16 @@ def run(args) -> int:
     emulator = Emulator.load(args.emulator)
     observed = read_table(args.observed)
     samples, summary, info = calibrate(emulator, args.shots, observed, config, source=args.observed,
-                                       particles=args.particles)
+                                       n_eff=args.n_eff)
     meta = {"table": "posterior samples", **info,
-            "columns": "equal-weight draws: inputs in `units`; lambda_y (-); log_likelihood (at the draw)"}
+            "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
+                       "log_likelihood (at the draw)"}
     write_table(samples, args.out, meta)
     write_table(summary, summary_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
     logging.getLogger("shockcal.calibrate").info(
-        "posterior of %s (%d draws, %d distinct, %d likelihood evaluations, log evidence %.3f):\n%s",
-        "+".join(args.shots), len(samples), info["distinct_draws"], info["likelihood_evaluations"],
+        "posterior of %s (Kish ESS %.0f, %d draws written, %d distinct, %d likelihood evaluations, "
+        "log evidence %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(samples), info["distinct_draws"],
+        info["likelihood_evaluations"],
         info["log_evidence"], summary.to_string(index=False, float_format="%.4g"))
     return 0
 
