@@ -1,13 +1,13 @@
-"""Calibration: the default sampler (adaptive SMC) against an independent reference, on the real data.
+"""Calibration: the default sampler (nautilus) against a long reference run, on the real data.
 
 For each calibration (joint, then each shot) on a fitted emulator and measured features:
   reference  nautilus run long (importance nested sampling, weighted draws), kept under
-             benchmarks/out/reference/ and reused; cross-checked by a long SMC run: the worst
-             quantile difference between the two independent methods, as a share of the box;
-  smc        the configured sampler with --replicates seeds: wall and CPU seconds, likelihood
-             evaluations, distinct draws, the ESS of each parameter's mean from the spread of the
+             --reference-dir and reused;
+  default    the configured sampler with --replicates seeds: wall and CPU seconds, likelihood
+             evaluations, Kish ESS, the ESS of each parameter's mean from the spread of the
              replicate means (posterior variance / variance of the means), the worst quantile error
              against the reference as a share of the box (5/25/50/75/95%), the mass at A > 800 MPa;
+  smc        (--smc) smcpy's adaptive SMC with --smc-particles and --smc-moves, the same measures;
   emcee      (--emcee) an emcee ensemble of the same length in likelihood evaluations, with
              ArviZ's R-hat and bulk ESS, as a yardstick.
 Goal (issue 14): ESS >= 1000 per parameter, worst quantile error <= 0.02 of the box, <= 60 s wall.
@@ -75,12 +75,57 @@ def quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> float
     return worst
 
 
-def run_smc(problem, particles, mcmc_steps, seed):
-    from shockcal.sampler import smc_sample
+def run_default(problem, settings, seed):
+    """The configured nautilus run: equal-weight draws (resampled), wall and CPU seconds, evaluations."""
+    from shockcal.sampler import nested_sample
 
     start, cpu = time.perf_counter(), time.process_time()
-    draws = smc_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, particles, mcmc_steps, seed)
-    return draws, time.perf_counter() - start, time.process_time() - cpu
+    draws = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings["n_live"],
+                          settings["n_eff"], seed)
+    points = draws.points[draws.resample(20000, np.random.default_rng(seed))]
+    return points, time.perf_counter() - start, time.process_time() - cpu, draws.n_likelihood
+
+
+def run_smc(problem, particles: int, moves: int, seed: int):
+    """smcpy's adaptive SMC on the unit cube (the sampler measured and not adopted; docs/calibration.md)."""
+    from scipy import stats
+    from smcpy import AdaptiveSampler, VectorMCMC, VectorMCMCKernel
+
+    evaluations = [0]
+
+    class CubeLikelihood:
+        def __init__(self, *_):
+            pass
+
+        def __call__(self, cube):
+            evaluations[0] += len(cube)
+            return problem.log_likelihood(problem.prior_transform(cube))[:, None]
+
+    start, cpu = time.perf_counter(), time.process_time()
+    mcmc = VectorMCMC(None, None, [stats.uniform(0.0, 1.0)] * problem.ndim, log_like_func=CubeLikelihood)
+    kernel = VectorMCMCKernel(mcmc, param_order=[f"u{i}" for i in range(problem.ndim)],
+                              rng=np.random.default_rng(seed))
+    steps, _ = AdaptiveSampler(kernel, show_progress_bar=False).sample(particles, moves, target_ess=0.8)
+    points = problem.prior_transform(steps[-1].params)
+    return points, time.perf_counter() - start, time.process_time() - cpu, evaluations[0]
+
+
+def report(label, runs, ref, names, width):
+    """Print the measures of replicate runs [(points, wall, cpu, evaluations), ...]."""
+    means = np.array([points.mean(axis=0) for points, *_ in runs])
+    variance = np.array([np.cov(ref[n], aweights=ref["weight"]) for n in names])
+    errors = [quantile_error(points, ref, names, width) for points, *_ in runs]
+    tip = [np.mean(points[:, names.index("A")] > TIP_A_MBAR) for points, *_ in runs] if "A" in names else [np.nan]
+    wall = np.median([r[1] for r in runs])
+    print(f"  {label} x{len(runs)}: wall {wall:.1f} s median, CPU {np.median([r[2] for r in runs]):.1f} s, "
+          f"{int(np.median([r[3] for r in runs]))} evaluations ({load()})")
+    if len(runs) > 1:
+        ess = variance / means.var(axis=0, ddof=1)
+        print(f"  {label} ESS of the mean per parameter (replicate spread): "
+              + ", ".join(f"{n} {e:.0f}" for n, e in zip(names, ess)) + f"; min {ess.min():.0f}")
+    print(f"  {label} worst quantile error vs reference: median {np.median(errors):.4f}, max {np.max(errors):.4f} "
+          f"of the box; mass at A > 800 MPa {np.mean(tip):.3f} (reference "
+          f"{ref['weight'][ref['A'] > TIP_A_MBAR].sum() if 'A' in names else np.nan:.3f})")
 
 
 def run_emcee(problem, evaluations: int, seed: int):
@@ -117,12 +162,15 @@ def main(argv=None) -> int:
                         help="measured features (default: the paper's published values)")
     parser.add_argument("--config", default=str(REPO / "config" / "config.yaml"))
     parser.add_argument("--only", nargs="+", choices=[*SHOTS, "joint"], default=["joint", *SHOTS])
-    parser.add_argument("--replicates", type=int, default=5)
+    parser.add_argument("--replicates", type=int, default=3)
     parser.add_argument("--reference-dir", default=str(REPO / "benchmarks" / "out" / "reference"),
                         help="where reference posteriors are kept (one per emulator: use one directory each)")
     parser.add_argument("--reference-live", type=int, default=2000)
     parser.add_argument("--reference-eff", type=int, default=20000)
-    parser.add_argument("--emcee", action="store_true", help="also run the emcee yardstick")
+    parser.add_argument("--smc", action="store_true", help="also run smcpy's adaptive SMC")
+    parser.add_argument("--smc-particles", type=int, default=4000)
+    parser.add_argument("--smc-moves", type=int, default=5)
+    parser.add_argument("--emcee", action="store_true", help="also run the emcee yardstick (60,000 evaluations)")
     args = parser.parse_args(argv)
     if not (Path(args.emulator) / "emulator.json").is_file():
         print(f"skipped: no emulator at {args.emulator} (shockcal emulate, or the study)")
@@ -130,8 +178,9 @@ def main(argv=None) -> int:
     config = load_config(args.config)
     emulator = Emulator.load(args.emulator)
     observed = read_table(args.observed)
-    particles, mcmc_steps = config["calibration"]["particles"], config["calibration"]["mcmc_steps"]
-    print(f"emulator {args.emulator}, observed {args.observed}; SMC {particles} particles, {mcmc_steps} moves")
+    settings = config["calibration"]
+    print(f"emulator {args.emulator}, observed {args.observed}; nautilus {settings['n_live']} live points, "
+          f"ESS {settings['n_eff']}")
     for name in args.only:
         shots = SHOTS if name == "joint" else [name]
         problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"])
@@ -139,27 +188,12 @@ def main(argv=None) -> int:
         ref = reference(problem, name, Path(args.reference_dir), args.reference_live, args.reference_eff)
         width = np.append(problem.upper - problem.lower, LAMBDA_Y_SPAN)
         print(f"== {name}: {len(names)} parameters")
-        long, seconds, _ = run_smc(problem, 5 * particles, 2 * mcmc_steps, seed=101)
-        print(f"  cross-check, SMC {5 * particles} particles x {2 * mcmc_steps} moves ({seconds:.0f} s): worst quantile "
-              f"difference from the reference {quantile_error(long.points, ref, names, width):.4f} of the box")
-        runs = [run_smc(problem, particles, mcmc_steps, seed) for seed in range(1, args.replicates + 1)]
-        means = np.array([d.points.mean(axis=0) for d, _, _ in runs])
-        variance = np.array([np.cov(ref[n], aweights=ref["weight"]) for n in names])
-        ess = variance / means.var(axis=0, ddof=1)
-        errors = [quantile_error(d.points, ref, names, width) for d, _, _ in runs]
-        tip = [np.mean(d.points[:, names.index("A")] > TIP_A_MBAR) for d, _, _ in runs] if "A" in names else [np.nan]
-        wall = np.median([s for _, s, _ in runs])
-        print(f"  smc x{args.replicates}: wall {wall:.1f} s median, CPU {np.median([c for _, _, c in runs]):.1f} s, "
-              f"{int(np.median([d.n_likelihood for d, _, _ in runs]))} evaluations, "
-              f"{int(np.median([len(np.unique(d.points, axis=0)) for d, _, _ in runs]))} distinct draws ({load()})")
-        print("  smc ESS of the mean per parameter (replicate spread): "
-              + ", ".join(f"{n} {e:.0f}" for n, e in zip(names, ess)) + f"; min {ess.min():.0f}, "
-              f"ESS/s {ess.min() / wall:.0f}")
-        print(f"  smc worst quantile error vs reference: median {np.median(errors):.4f}, max {np.max(errors):.4f} "
-              f"of the box; tip mass A > 800 MPa {np.mean(tip):.3f} (reference "
-              f"{ref['weight'][ref['A'] > TIP_A_MBAR].sum() if 'A' in names else np.nan:.3f})")
+        report("default", [run_default(problem, settings, seed) for seed in range(1, args.replicates + 1)],
+               ref, names, width)
+        if args.smc:
+            report("smc", [run_smc(problem, args.smc_particles, args.smc_moves, seed=1)], ref, names, width)
         if args.emcee:
-            evaluations = int(np.median([d.n_likelihood for d, _, _ in runs]))
+            evaluations = 60000
             draws, seconds, rhat, ess_bulk = run_emcee(problem, evaluations, seed=1)
             print(f"  emcee, {evaluations} evaluations: {seconds:.1f} s, max R-hat {rhat:.3f}, min bulk ESS "
                   f"{ess_bulk:.0f} (ArviZ), worst quantile error {quantile_error(draws, ref, names, width):.4f}")
