@@ -26,6 +26,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from shockcal.calibration import weighted_quantiles
+
 REPO = Path(__file__).resolve().parents[1]
 QUANTILES = [0.05, 0.25, 0.5, 0.75, 0.95]
 TIP_A_MBAR = 0.008           # A > 800 MPa: the thin arm of the A-m posterior
@@ -35,13 +37,6 @@ LAMBDA_Y_SPAN = 2.33         # lambda_y's "box": the 99.5% quantile of its Gamma
 
 def load() -> str:
     return f"load {os.getloadavg()[0]:.1f}"
-
-
-def weighted_quantiles(x, w, q):
-    """Quantiles of weighted draws: the inverse of the midpoint-interpolated weighted CDF."""
-    order = np.argsort(x)
-    cdf = np.cumsum(w[order]) - 0.5 * w[order]
-    return np.interp(q, cdf / w.sum(), x[order])
 
 
 def reference(problem, name: str, directory: Path, n_live: int, n_eff: int) -> pd.DataFrame:

@@ -7,8 +7,8 @@ For the shots calibrated together, the measured features y (m/s, four per shot) 
 eta and C_eta the emulator's predictive mean and covariance, Sigma_y diagonal with sd =
 `observed.sd_fraction` (1%) of each measured feature, lambda_y ~ Gamma(5, 5), theta uniform on the
 prior box. The emulator's hyperparameters are fixed at their fitted mode (modular Bayes; see
-docs/calibration.md). The sampled vector is (theta in native units, log lambda_y); the density
-includes the Jacobian of the log.
+docs/calibration.md). A point is (theta in native units, lambda_y); both priors are reached from the
+unit cube (`Problem.prior_transform`).
 
 Sampling (`shockcal.sampler`): importance nested sampling (nautilus) from the unit cube through
 `Problem.prior_transform`, with the batch log-likelihood `Problem.log_likelihood`.
@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
@@ -69,8 +70,6 @@ class Problem:
 
     def prior_transform(self, u: np.ndarray) -> np.ndarray:
         """Unit cube (N, d + 1) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5))."""
-        from scipy import stats
-
         u = np.atleast_2d(u)
         shape, rate = LAMBDA_Y_PRIOR
         theta = self.lower + u[:, :-1] * (self.upper - self.lower)
@@ -100,9 +99,9 @@ class Problem:
         inside = np.all((x[:, :-1] >= self.lower) & (x[:, :-1] <= self.upper), axis=1) & np.isfinite(x[:, -1])
         if inside.any():
             log_lam = x[inside, -1]
+            lam = np.exp(log_lam)
             shape, rate = LAMBDA_Y_PRIOR
-            points = np.column_stack([x[inside, :-1], np.exp(log_lam)])
-            out[inside] = self.log_likelihood(points) + shape * log_lam - rate * np.exp(log_lam)
+            out[inside] = self.log_likelihood(np.column_stack([x[inside, :-1], lam])) + shape * log_lam - rate * lam
         return out
 
 
@@ -165,14 +164,14 @@ def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, p
 
 def summarize(draws: WeightedDraws, names: list[str]) -> pd.DataFrame:
     """Per parameter: weighted mean, sd, 5/50/95% quantiles, and the Kish ESS of the weights."""
-    w = draws.weights
+    w, ess = draws.weights, draws.kish_ess()
     rows = []
     for j, name in enumerate(names):
         x = draws.points[:, j]
         mean = float(np.sum(w * x))
         q05, q50, q95 = weighted_quantiles(x, w, [0.05, 0.5, 0.95])
         rows.append({"parameter": name, "mean": mean, "sd": float(np.sqrt(np.sum(w * (x - mean) ** 2))),
-                     "q05": q05, "q50": q50, "q95": q95, "ess": draws.kish_ess()})
+                     "q05": q05, "q50": q50, "q95": q95, "ess": ess})
     return pd.DataFrame(rows)
 
 
@@ -278,8 +277,6 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), the central 95%
     binomial band of that share for a calibrated method (band_low, band_high), whether it lies in the
     band, and the smallest Kish ESS of any trial."""
-    from scipy import stats
-
     table = trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
                                                         min_ess=("ess", "min")).reset_index()
     table["band_low"] = stats.binom.ppf(0.025, table["trials"], 0.9) / table["trials"]
