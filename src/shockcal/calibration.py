@@ -28,6 +28,7 @@ from shockcal.emulator import CALIBRATION_FEATURES
 from shockcal.errors import InputError
 from shockcal.plausibility import check_observed_table
 from shockcal.sampler import WeightedDraws, nested_sample
+from shockcal.seeds import stream_seed
 
 log = logging.getLogger("shockcal.calibration")
 LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
@@ -186,12 +187,13 @@ def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str
               **overrides) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Calibrate `shots` jointly (one shot = single-shot calibration): samples, summary, run info.
 
-    `overrides` replace keys of config["calibration"] (n_live, n_eff, draws, seed).
+    `overrides` replace keys of config["calibration"] (n_live, n_eff, draws) or set the sampler `seed`
+    (default: the "calibration" stream of study.seed, keyed by the shots).
     """
     problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"], source)
     check_observed_table(observed, shots, source, config["checks"]["observed_units"])
     calibration = {**config["calibration"], **{k: v for k, v in overrides.items() if v is not None}}
-    seed = calibration.get("seed", config["study"]["seed"] + calibration["seed_offset"])
+    seed = calibration.get("seed", stream_seed(config["study"]["seed"], "calibration", *shots))
     settings = SamplerSettings(calibration["n_live"], calibration["n_eff"], calibration["draws"], seed)
     samples, summary, info = sample(problem, settings)
     units = {**{k: config["inputs"][k]["unit"] for k in problem.names}, "lambda_y": "-"}
@@ -289,8 +291,9 @@ def coverage_check(emulator, shots, config: dict, trials: int | None = None,
                    truths: HydroTruths | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The configured synthetic-truth check (calibration.check), on emulator or hydrocode truth:
     per-trial table and coverage per parameter."""
-    settings, check = config["calibration"], config["calibration"]["check"]
+    check = config["calibration"]["check"]
+    truth = "emulator" if truths is None else "hydrocode"
     table = synthetic_truth(emulator, shots, config, trials or check["trials"],
-                            seed=config["study"]["seed"] + settings["seed_offset"] + 1, truths=truths,
+                            seed=stream_seed(config["study"]["seed"], "check", truth, *shots), truths=truths,
                             n_live=check["n_live"], n_eff=check["n_eff"], draws=check["n_eff"])
     return table, coverage_table(table)

@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 from shockcal.config import STRENGTH_INPUTS, shot_config
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
+from shockcal.seeds import stream_seed
 
 FORMAT_VERSION = 2
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -134,7 +135,7 @@ class HeldOut:
     sd: np.ndarray
 
 
-def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int) -> Hyper:
+def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence) -> Hyper:
     """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
@@ -201,11 +202,12 @@ class PCGPEmulator:
             weights = u[:, :p] * np.sqrt(n)                   # unit-variance weights
             basis = vt[:p] * (s[:p, None] / np.sqrt(n))       # z ~ weights @ basis
             residual = z - weights @ basis
-            rng = np.random.default_rng(settings.seed)
-            fit_rows = (None if n <= settings.max_fit_runs
-                        else np.sort(rng.choice(n, settings.max_fit_runs, replace=False)))
+            # children of the seed: the fit subset, then one per component's GP starts (the root draws the folds)
+            subset_seed, *component_seeds = np.random.SeedSequence(settings.seed).spawn(1 + p)
+            fit_rows = (None if n <= settings.max_fit_runs else
+                        np.sort(np.random.default_rng(subset_seed).choice(n, settings.max_fit_runs, replace=False)))
             parts.append((x, y, mean, scale, basis, residual.T @ residual / n))
-            tasks += [(x, weights[:, j], fit_rows, settings, settings.seed + j) for j in range(p)]
+            tasks += [(x, weights[:, j], fit_rows, settings, component_seeds[j]) for j in range(p)]
         if settings.n_jobs > 1:
             hypers = Parallel(n_jobs=settings.n_jobs)(delayed(_fit_hyper)(*t) for t in tasks)
         else:
@@ -524,7 +526,7 @@ def fit_emulator(config: dict, design: pd.DataFrame, features: dict[str, pd.Data
     blocks = []
     for i, (block_shots, input_map, table, label, columns) in enumerate(groups):
         _check_training_inputs(table, input_map, label)
-        settings = Settings.from_config(config["emulator"], config["study"]["seed"] + 100 * i)
+        settings = Settings.from_config(config["emulator"], stream_seed(config["study"]["seed"], "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
                                  settings)
         log.info("emulator %s: %d runs, %d inputs, %d of %d components, %s correlation", "+".join(block_shots),

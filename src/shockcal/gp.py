@@ -151,7 +151,7 @@ class GaussianProcess:
         self.inv_cov = _inverse_from_cholesky(self.factor[0])
 
     @classmethod
-    def fit(cls, x, y, n_starts: int = 4, seed: int = 0, jitter: float = 1e-8, fit_rows=None,
+    def fit(cls, x, y, n_starts: int = 4, seed: int | np.random.SeedSequence = 0, jitter: float = 1e-8, fit_rows=None,
             family: str = "gaussian", fit_mean: bool = False) -> GaussianProcess:
         """MAP hyperparameters (L-BFGS-B from several starts), then condition on all of (x, y).
 

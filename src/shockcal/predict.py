@@ -18,9 +18,6 @@ from shockcal.io import require_columns
 
 log = logging.getLogger(__name__)
 
-SEED_OFFSET = 7  # posterior draws use study.seed + SEED_OFFSET, apart from the other stages' streams
-
-
 def draw_posterior_design(posterior: pd.DataFrame, config: dict, n: int, seed: int,
                           source: str = "posterior") -> pd.DataFrame:
     """`n` rows drawn (seeded, without replacement when possible) from the posterior samples.

@@ -74,6 +74,7 @@ for _name, _spec in FIGURE_SPECS.items():
             out_dir=lambda w, output: os.path.dirname(output[0]),
             inputs=" ".join(f"--input {key}={path}" for key, paths in _files.items() for path in paths),
             figures=config["figures"],
+            seed=config["study"]["seed"] if _name in HISTORY_SHOTS else None,  # seeds.py: the figures stream
         log:
             f"{LOGS}/figures/{_name}.log",
         benchmark:

@@ -34,7 +34,7 @@ rule check_design:
     params:
         trials=RUN_SETS["check"],
         inputs=config["inputs"],
-        seed=config["study"]["seed"] + config["calibration"]["seed_offset"] + 2,
+        seed=config["study"]["seed"],
     log:
         f"{LOGS}/check/design.log",
     benchmark:
@@ -42,7 +42,7 @@ rule check_design:
     conda:
         "../envs/shockcal.yaml"
     shell:
-        "shockcal design --lhs --n-runs {params.trials} --seed {params.seed}"
+        "shockcal design --lhs --n-runs {params.trials} --stream check_design"
         " --out {output} > {log} 2>&1"
 
 

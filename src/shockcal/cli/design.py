@@ -11,6 +11,8 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="output Parquet design table")
     p.add_argument("--n-runs", type=int, default=None, help="override design.n_runs")
     p.add_argument("--seed", type=int, default=None, help="override study.seed")
+    p.add_argument("--stream", default="design", choices=["design", "check_design"],
+                   help="the random stream of study.seed the hypercube draws from (shockcal.seeds)")
     p.add_argument("--lhs", action="store_true",
                    help="a Latin hypercube over the box even when the config names a design file")
     p.set_defaults(func=run)
@@ -22,6 +24,7 @@ def run(args) -> int:
     from shockcal.config import input_names, load_config
     from shockcal.design import latin_hypercube, load_design
     from shockcal.io import write_table
+    from shockcal.seeds import stream_seed
 
     config = load_config(args.config)
     log = logging.getLogger("shockcal.design")
@@ -32,7 +35,7 @@ def run(args) -> int:
             design = design.iloc[: args.n_runs]
     else:
         n_runs = args.n_runs or config["design"]["n_runs"]
-        seed = config["study"]["seed"] if args.seed is None else args.seed
+        seed = stream_seed(config["study"]["seed"], args.stream) if args.seed is None else args.seed
         design = latin_hypercube(config, n_runs, seed)
         source = f"Latin hypercube, seed {seed}"
     units = {name: config["inputs"][name]["unit"] for name in input_names(config)}

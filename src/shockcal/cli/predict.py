@@ -11,7 +11,7 @@ def register(subparsers) -> None:
     p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
     p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
     p.add_argument("--n-runs", type=int, default=None, help="override predict.n_posterior_runs")
-    p.add_argument("--seed", type=int, default=None, help="override the seed (default: study.seed + offset)")
+    p.add_argument("--seed", type=int, default=None, help="override the seed (default: the study's posterior_draws stream)")
     p.set_defaults(func=run)
 
     e = subparsers.add_parser("predict-emulator", help="emulator predictions of the features at a design's rows")
@@ -27,11 +27,12 @@ def run(args) -> int:
 
     from shockcal.config import load_config
     from shockcal.io import read_table, write_table
-    from shockcal.predict import SEED_OFFSET, draw_posterior_design
+    from shockcal.predict import draw_posterior_design
+    from shockcal.seeds import stream_seed
 
     config = load_config(args.config)
     n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
-    seed = config["study"]["seed"] + SEED_OFFSET if args.seed is None else args.seed
+    seed = stream_seed(config["study"]["seed"], "posterior_draws") if args.seed is None else args.seed
     design = draw_posterior_design(read_table(args.posterior), config, n_runs, seed, source=args.posterior)
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",

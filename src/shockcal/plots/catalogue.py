@@ -18,6 +18,7 @@ from functools import partial
 from typing import TYPE_CHECKING
 
 from shockcal.errors import InputError
+from shockcal.seeds import stream_seed
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -138,7 +139,7 @@ def _history(shot, inputs, config):
         aligned_to = inputs.table(f"features:{shot}")
     return fig_history(shot, inputs.table(f"simulations:{shot}"), inputs.table(f"predicted_simulations:{shot}"),
                        measured, inputs.record(shot, config), estimate_time_shift(measured, aligned_to),
-                       seed=config["study"]["seed"])
+                       seed=stream_seed(config["study"]["seed"], "figures"))
 
 
 def history_names(config) -> dict[str, str]:
