@@ -42,9 +42,10 @@ bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); inst
 validate: $(INSTALLED)  ## our hydrocode + extractor against the paper's FLAG features and measured features
 	$(PY) benchmarks/validate_flag.py
 
-lint: $(INSTALLED)  ## ruff on the package, tests and benchmarks; snakemake's own lint of the rules
+lint: $(INSTALLED)  ## ruff on the package, tests and benchmarks; snakefmt and snakemake's own lint on the rules
 	$(PY) -m pip install --quiet -e '.[test,lint]'
 	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/snakefmt --check Snakefile workflow/
 	snakemake --lint
 
 clean:

@@ -10,20 +10,20 @@ rule calibrate:
     output:
         samples=f"{RESULTS}/posterior/{{name}}.parquet",
         summary=f"{RESULTS}/posterior/{{name}}_summary.parquet",
+    log:
+        f"{LOGS}/calibrate/{{name}}.log",
+    benchmark:
+        f"{BENCHMARKS}/calibrate/{{name}}.tsv"
     wildcard_constraints:
         name="|".join(CALIBRATIONS),
+    conda:
+        "../envs/shockcal.yaml"
     params:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
         seed=config["study"]["seed"],
         shots=lambda w: " ".join(SHOTS if w.name == "joint" else [w.name]),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
-    log:
-        f"{LOGS}/calibrate/{{name}}.log",
-    benchmark:
-        f"{BENCHMARKS}/calibrate/{{name}}.tsv"
-    conda:
-        "../envs/shockcal.yaml"
     shell:
         "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots}"
         " --observed {input.observed} --out {output.samples} > {log} 2>&1"
@@ -34,18 +34,18 @@ rule calibration_check:
         emulator=f"{RESULTS}/emulator/emulator.json",
     output:
         f"{RESULTS}/posterior/coverage.parquet",
-    params:
-        calibration=config["calibration"],
-        sd_fraction=config["observed"]["sd_fraction"],
-        seed=config["study"]["seed"],
-        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
-        shots=" ".join(SHOTS),
     log:
         f"{LOGS}/calibrate/coverage.log",
     benchmark:
         f"{BENCHMARKS}/calibrate/coverage.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        calibration=config["calibration"],
+        sd_fraction=config["observed"]["sd_fraction"],
+        seed=config["study"]["seed"],
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+        shots=" ".join(SHOTS),
     shell:
         "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
         " --out {output} > {log} 2>&1"
@@ -58,6 +58,12 @@ rule calibration_check_hydrocode:
         features=expand(f"{RESULTS}/check/features/{{shot}}.parquet", shot=SHOTS),
     output:
         f"{RESULTS}/posterior/coverage_hydrocode.parquet",
+    log:
+        f"{LOGS}/calibrate/coverage_hydrocode.log",
+    benchmark:
+        f"{BENCHMARKS}/calibrate/coverage_hydrocode.tsv"
+    conda:
+        "../envs/shockcal.yaml"
     params:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
@@ -65,12 +71,6 @@ rule calibration_check_hydrocode:
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
         pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
         shots=" ".join(SHOTS),
-    log:
-        f"{LOGS}/calibrate/coverage_hydrocode.log",
-    benchmark:
-        f"{BENCHMARKS}/calibrate/coverage_hydrocode.tsv"
-    conda:
-        "../envs/shockcal.yaml"
     shell:
         "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
         " --truth-design {input.design} --truth-features {params.pairs} --out {output} > {log} 2>&1"

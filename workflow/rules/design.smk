@@ -4,15 +4,15 @@
 rule design:
     output:
         f"{RESULTS}/design.parquet",
-    params:
-        design=config["design"],
-        inputs=config["inputs"],
-        seed=config["study"]["seed"],
     log:
         f"{LOGS}/design.log",
     benchmark:
         f"{BENCHMARKS}/design.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        design=config["design"],
+        inputs=config["inputs"],
+        seed=config["study"]["seed"],
     shell:
         "shockcal design --out {output} > {log} 2>&1"

@@ -13,21 +13,20 @@ rule emulator:
         cv=f"{RESULTS}/emulator/cv.parquet",
         heldout=f"{RESULTS}/emulator/cv_heldout.parquet",
         rmse=f"{RESULTS}/emulator/cv_rmse.csv",
+    log:
+        f"{LOGS}/emulator.log",
+    benchmark:
+        f"{BENCHMARKS}/emulator.tsv"
+    conda:
+        "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]
     params:
         emulator=config["emulator"],
         seed=config["study"]["seed"],
         pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
         out=lambda w, output: os.path.dirname(output.emulator),
-    log:
-        f"{LOGS}/emulator.log",
-    benchmark:
-        f"{BENCHMARKS}/emulator.tsv"
-    threads: config["emulator"]["n_jobs"]
-    conda:
-        "../envs/shockcal.yaml"
     shell:
-        "shockcal emulate --design {input.design} --features {params.pairs}"
-        " --out {params.out} > {log} 2>&1"
+        "shockcal emulate --design {input.design} --features {params.pairs}" " --out {params.out} > {log} 2>&1"
 
 
 ALL_TARGETS.append(f"{RESULTS}/emulator/cv_rmse.csv")

@@ -6,16 +6,16 @@ rule features:
         expand(f"{RESULTS}/simulations/{{{{shot}}}}/chunk-{{chunk}}.parquet", chunk=CHUNKS),
     output:
         f"{RESULTS}/features/{{shot}}.parquet",
-    params:
-        features=config["features"],
-        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
-        max_failed_fraction=config["simulate"]["max_failed_fraction"],
     log:
         f"{LOGS}/features/{{shot}}.log",
     benchmark:
         f"{BENCHMARKS}/features/{{shot}}.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        features=config["features"],
+        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
+        max_failed_fraction=config["simulate"]["max_failed_fraction"],
     shell:
         "shockcal features --shot {wildcards.shot} --traces {input} --out {output} > {log} 2>&1"
 
@@ -27,16 +27,16 @@ rule observed:
         else [],
     output:
         f"{RESULTS}/features/observed.parquet",
-    params:
-        observed=config["observed"],
-        features=config["features"],
-        analysis={shot: spec.get("analysis", {}) for shot, spec in config["shots"].items()},
     log:
         f"{LOGS}/observed.log",
     benchmark:
         f"{BENCHMARKS}/observed.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        observed=config["observed"],
+        features=config["features"],
+        analysis={shot: spec.get("analysis", {}) for shot, spec in config["shots"].items()},
     shell:
         "shockcal observed --out {output} > {log} 2>&1"
 

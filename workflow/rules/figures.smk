@@ -68,6 +68,12 @@ for _name, _spec in FIGURE_SPECS.items():
                 category=_spec.category,
             ),
             [f"{RESULTS}/figures/{_name}.{fmt}" for fmt in FIGURE_FORMATS if fmt != REPORT_FORMAT],
+        log:
+            f"{LOGS}/figures/{_name}.log",
+        benchmark:
+            f"{BENCHMARKS}/figures/{_name}.tsv"
+        conda:
+            "../envs/shockcal.yaml"
         params:
             figure=_name,
             shot=HISTORY_SHOTS.get(_name, ""),
@@ -75,15 +81,8 @@ for _name, _spec in FIGURE_SPECS.items():
             inputs=" ".join(f"--input {key}={path}" for key, paths in _files.items() for path in paths),
             figures=config["figures"],
             seed=config["study"]["seed"] if _name in HISTORY_SHOTS else None,  # seeds.py: the figures stream
-        log:
-            f"{LOGS}/figures/{_name}.log",
-        benchmark:
-            f"{BENCHMARKS}/figures/{_name}.tsv"
-        conda:
-            "../envs/shockcal.yaml"
         shell:
-            "shockcal figures --figure {params.figure} --out-dir {params.out_dir}"
-            " {params.inputs} > {log} 2>&1"
+            "shockcal figures --figure {params.figure} --out-dir {params.out_dir}" " {params.inputs} > {log} 2>&1"
 
 
 ALL_TARGETS.extend(f"{RESULTS}/figures/{name}.{fmt}" for name in FIGURE_SPECS for fmt in FIGURE_FORMATS)

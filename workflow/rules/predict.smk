@@ -15,15 +15,15 @@ rule predict_design:
         posterior=f"{RESULTS}/posterior/joint.parquet",
     output:
         f"{PREDICT}/design.parquet",
-    params:
-        predict=config["predict"],
-        seed=config["study"]["seed"],
     log:
         f"{LOGS}/predict/design.log",
     benchmark:
         f"{BENCHMARKS}/predict/design.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        predict=config["predict"],
+        seed=config["study"]["seed"],
     shell:
         "shockcal predict --posterior {input.posterior} --out {output} > {log} 2>&1"
 
@@ -31,19 +31,18 @@ rule predict_design:
 rule check_design:
     output:
         f"{RESULTS}/check/design.parquet",
-    params:
-        trials=RUN_SETS["check"],
-        inputs=config["inputs"],
-        seed=config["study"]["seed"],
     log:
         f"{LOGS}/check/design.log",
     benchmark:
         f"{BENCHMARKS}/check/design.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        trials=RUN_SETS["check"],
+        inputs=config["inputs"],
+        seed=config["study"]["seed"],
     shell:
-        "shockcal design --lhs --n-runs {params.trials} --stream check_design"
-        " --out {output} > {log} 2>&1"
+        "shockcal design --lhs --n-runs {params.trials} --stream check_design" " --out {output} > {log} 2>&1"
 
 
 rule run_set_simulate:
@@ -51,17 +50,17 @@ rule run_set_simulate:
         design=f"{RESULTS}/{{run_set}}/design.parquet",
     output:
         f"{RESULTS}/{{run_set}}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
-    wildcard_constraints:
-        run_set="|".join(RUN_SETS),
-    params:
-        physics=lambda w: physics_slice(config, w.shot),
-        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
     log:
         f"{LOGS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
         f"{BENCHMARKS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
+    wildcard_constraints:
+        run_set="|".join(RUN_SETS),
     conda:
         "../envs/shockcal.yaml"
+    params:
+        physics=lambda w: physics_slice(config, w.shot),
+        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
         " --rows {params.rows} --out {output} > {log} 2>&1"
@@ -74,21 +73,20 @@ rule run_set_features:
         ),
     output:
         f"{RESULTS}/{{run_set}}/features/{{shot}}.parquet",
-    wildcard_constraints:
-        run_set="|".join(RUN_SETS),
-    params:
-        features=config["features"],
-        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
-        max_failed_fraction=config["simulate"]["max_failed_fraction"],
     log:
         f"{LOGS}/{{run_set}}/features/{{shot}}.log",
     benchmark:
         f"{BENCHMARKS}/{{run_set}}/features/{{shot}}.tsv"
+    wildcard_constraints:
+        run_set="|".join(RUN_SETS),
     conda:
         "../envs/shockcal.yaml"
+    params:
+        features=config["features"],
+        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
+        max_failed_fraction=config["simulate"]["max_failed_fraction"],
     shell:
-        "shockcal features --shot {wildcards.shot} --traces {input} --out {output}"
-        " > {log} 2>&1"
+        "shockcal features --shot {wildcards.shot} --traces {input} --out {output}" " > {log} 2>&1"
 
 
 rule predict_emulator:
@@ -98,14 +96,14 @@ rule predict_emulator:
         arrays=f"{RESULTS}/emulator/emulator.npz",
     output:
         f"{PREDICT}/emulator.parquet",
-    params:
-        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     log:
         f"{LOGS}/predict/emulator.log",
     benchmark:
         f"{BENCHMARKS}/predict/emulator.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
         "shockcal predict-emulator --design {input.design}"
         " --emulator {params.emulator_dir} --out {output} > {log} 2>&1"

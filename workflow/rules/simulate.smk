@@ -8,16 +8,16 @@ rule simulate:
         design=ancient(f"{RESULTS}/design.parquet"),
     output:
         f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
-    params:
-        physics=lambda w: physics_slice(config, w.shot),
-        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
-        rows_digest=lambda w: CHUNK_DIGESTS[int(w.chunk)],
     log:
         f"{LOGS}/simulate/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
         f"{BENCHMARKS}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
     conda:
         "../envs/shockcal.yaml"
+    params:
+        physics=lambda w: physics_slice(config, w.shot),
+        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
+        rows_digest=lambda w: CHUNK_DIGESTS[int(w.chunk)],
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
         " --rows {params.rows} --out {output} > {log} 2>&1"
