@@ -5,6 +5,7 @@ not here. Each case is (fault, error type, fragments the message must hold)."""
 
 from __future__ import annotations
 
+import errno
 import os
 import subprocess
 import sys
@@ -16,12 +17,13 @@ import pytest
 import yaml
 
 from shockcal.calibration import calibrate
-from shockcal.cli import parse_pairs
+from shockcal.cli import main, parse_pairs
 from shockcal.cli.features import check_failures
 from shockcal.cli.simulate import parse_rows
 from shockcal.config import load_config, validate_config
 from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
 from shockcal.errors import ConfigError, InputError, ShockcalError
+from shockcal.io import atomic_path, read_table, write_table
 from shockcal.records import OPT_OUT, read_record
 
 REPO = Path(__file__).resolve().parents[1]
@@ -297,3 +299,59 @@ def test_command_line_faults():
     failed = pd.DataFrame({"run": [0, 1, 2], "status": ["ok", "failed", "failed"], "reason": ["", "NaN", "NaN"]})
     with pytest.raises(ShockcalError, match=r"shot 104S: 2 of 3 runs failed.*\n  run 1: NaN"):
         check_failures(failed, 0.05, "104S")
+
+
+# ---- disks ----------------------------------------------------------------------------------------
+
+DISK_FAULTS = {"full": (errno.ENOSPC, "No space left on device"), "read-only": (errno.EROFS, "Read-only file system"),
+               "no-permission": (errno.EACCES, "Permission denied")}
+
+
+@pytest.mark.parametrize("fault", DISK_FAULTS)
+def test_disk_fault_is_one_line_and_leaves_nothing_that_looks_finished(tmp_path, monkeypatch, capsys, fault):
+    import pyarrow.parquet as pq
+
+    code, message = DISK_FAULTS[fault]
+    real_write = pq.write_table
+
+    def half_written(table, where, **kwargs):                 # half a file on disk, then the disk gives out
+        real_write(table, where, **kwargs)
+        Path(where).write_bytes(Path(where).read_bytes()[:100])
+        raise OSError(code, message, str(where))
+
+    monkeypatch.setattr(pq, "write_table", half_written)
+    out = tmp_path / "results" / "design.parquet"
+    rc = main(["design", "--config", str(REPO / "config" / "config.yaml"), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2
+    assert len(err) == 1 and err[0].startswith("shockcal design: error: ") and message in err[0], err
+    assert list(out.parent.iterdir()) == [], "a half-written file was left behind"
+
+
+def test_an_interrupted_write_keeps_the_finished_file(tmp_path):
+    path = tmp_path / "table.parquet"
+    write_table(pd.DataFrame({"run": [0, 1]}), path)
+    with pytest.raises(KeyboardInterrupt), atomic_path(path) as tmp:
+        tmp.write_bytes(b"PAR1 half")
+        raise KeyboardInterrupt
+    assert read_table(path)["run"].tolist() == [0, 1]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.parquet"]
+
+
+def test_temporaries_of_a_killed_writer_are_swept(tmp_path):
+    path = tmp_path / "chunk-0.parquet"
+    (tmp_path / ".chunk-0.parquet.tmp-12345.parquet").write_bytes(b"PAR1 left by kill -9")
+    write_table(pd.DataFrame({"run": [0]}), path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["chunk-0.parquet"]
+
+
+def test_truncated_chunk_is_named_with_the_way_out(tmp_path, capsys):
+    chunk = tmp_path / "chunk-3.parquet"
+    write_table(pd.DataFrame({"run": np.arange(50), "time_us": np.linspace(0, 1, 50)}), chunk)
+    chunk.write_bytes(chunk.read_bytes()[:-40])                # a chunk cut short (disk full, copy interrupted)
+    rc = main(["features", "--config", str(REPO / "config" / "config.yaml"), "--shot", "104S",
+               "--traces", str(chunk), "--out", str(tmp_path / "features.parquet")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1, err
+    assert f"table {chunk} could not be read" in err[0] and "delete it and rerun" in err[0]
+    assert not (tmp_path / "features.parquet").exists()

@@ -168,6 +168,24 @@ def test_a_seed_change_flags_exactly_the_seeded_stages(study, tmp_path):
     assert not unseeded, sorted(unseeded)
 
 
+def test_deleted_intermediates_rerun_only_their_dependents(study):
+    """A deleted simulation chunk reruns that chunk and what depends on it; a deleted features table
+    reruns its shot's features and what follows, and no simulation."""
+    results, config = study
+    chunk = results / "simulations" / "104S" / "chunk-1.parquet"
+    features = results / "features" / "105S.parquet"
+    kept = {path: path.with_name(path.name + ".kept") for path in (chunk, features)}
+    for path, aside in kept.items():
+        path.rename(aside)
+    try:
+        jobs = pending_jobs(config)
+    finally:
+        for path, aside in kept.items():
+            aside.rename(path)
+    assert jobs["simulate"] == 1 and jobs["features"] == 2 and jobs["emulator"] == 1, jobs
+    assert pending_jobs(config) == {}
+
+
 def test_bad_config_is_rejected_before_any_job(tmp_path):
     bad = overlay(tmp_path / "bad.yaml", simulate={"chunk_size": 0})
     done = snakemake("all", "--dry-run", config_files=[bad], check=False)
@@ -175,7 +193,11 @@ def test_bad_config_is_rejected_before_any_job(tmp_path):
     assert "simulate.chunk_size" in done.stdout + done.stderr
 
 
-def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path, sig):
+    """Ctrl-C or kill -9 in the middle of the fan-out; while it runs a second snakemake on the same
+    directory is refused by the lock; the rerun (after `--unlock` when kill -9 left the lock behind)
+    recomputes only the missing chunks and gives the same tables as the uninterrupted study."""
     results, _ = study
     resumed = tmp_path / "results"
     config = overlay(tmp_path / "resumed.yaml", study={"results_dir": str(resumed)})
@@ -185,12 +207,21 @@ def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path):
     deadline = time.monotonic() + 120
     while not any(chunks.glob("chunk-*.parquet")) and time.monotonic() < deadline and run.poll() is None:
         time.sleep(0.1)                                         # the first chunk done, whichever snakemake ran first
-    os.killpg(run.pid, signal.SIGINT)                           # Ctrl-C in the middle of the fan-out
+    if sig == signal.SIGINT:
+        second = snakemake(str(target), "--cores", "1", config_files=[config], check=False)
+        assert second.returncode != 0 and "cannot be locked" in second.stdout + second.stderr, second.stdout[-2000:]
+    os.killpg(run.pid, sig)                                     # in the middle of the fan-out
     run.communicate(timeout=120)
-    finished = sorted(p.name for p in chunks.glob("chunk-*.parquet"))
+    finished = {p.name: p.stat().st_mtime_ns for p in chunks.glob("chunk-*.parquet")}
     assert 1 <= len(finished) < 4 and not target.exists(), finished
 
+    if sig == signal.SIGKILL:                                   # snakemake had no chance to release its lock
+        refused = snakemake(str(target), "--cores", "2", config_files=[config], check=False)
+        assert refused.returncode != 0 and "--unlock" in refused.stdout + refused.stderr
+        snakemake("--unlock", config_files=[config])
     snakemake(str(target), "--cores", "2", config_files=[config])
+    assert {name: (chunks / name).stat().st_mtime_ns for name in finished} == finished, "a finished chunk was rerun"
+    assert not list(chunks.glob(".*tmp*")), "temporaries left behind"
     for k in range(4):
         ours = pd.read_parquet(chunks / f"chunk-{k}.parquet").drop(columns="wall_time_s")
         reference = pd.read_parquet(results / "simulations" / "104S" / f"chunk-{k}.parquet").drop(columns="wall_time_s")

@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 from shockcal.config import STRENGTH_INPUTS, shot_config
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
+from shockcal.io import atomic_path
 from shockcal.seeds import stream_seed
 
 FORMAT_VERSION = 2
@@ -311,7 +312,8 @@ class PCGPEmulator:
         """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
         path = Path(path)
         header = {"format": "shockcal-pcgp", "version": FORMAT_VERSION, **self.to_json()}
-        np.savez(path, header=np.array(json.dumps(header)), **self.to_arrays())
+        with atomic_path(path) as tmp:
+            np.savez(tmp, header=np.array(json.dumps(header)), **self.to_arrays())
         return path
 
     @classmethod
@@ -444,13 +446,15 @@ class Emulator:
         for i, block in enumerate(self.blocks):
             arrays.update(block.model.to_arrays(f"block{i}/"))
             arrays[f"block{i}/runs"] = block.runs
-        np.savez(directory / "emulator.npz", **arrays)
+        with atomic_path(directory / "emulator.npz") as tmp:
+            np.savez(tmp, **arrays)
         meta = {"format": "shockcal-emulator", "version": FORMAT_VERSION, "structure": self.structure,
                 "feature_names": self.feature_names, "feature_units": "m/s",
                 "input_bounds": {k: list(v) for k, v in self._bounds.items()}, "shot_inputs": self._shot_inputs,
                 "blocks": [{"shots": b.shots, "inputs": b.input_map.to_json(), **b.model.to_json()}
                            for b in self.blocks]}
-        (directory / "emulator.json").write_text(json.dumps(meta, indent=1))
+        with atomic_path(directory / "emulator.json") as tmp:     # written last: it marks a finished save
+            tmp.write_text(json.dumps(meta, indent=1))
         return directory
 
     @classmethod

@@ -8,6 +8,7 @@ leaves a half-written table that a rerun would mistake for a finished one.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from pathlib import Path
@@ -33,7 +34,9 @@ def read_table(path: str | Path) -> pd.DataFrame:
         if suffix in CSV_SUFFIXES:
             return pd.read_csv(path)
     except Exception as exc:  # pyarrow and pandas raise many types; all mean "unreadable"
-        raise InputError(f"table {path} could not be read: {exc}") from exc
+        hint = (" (truncated or corrupted? if shockcal wrote it, delete it and rerun: snakemake recomputes only"
+                " the missing files)") if suffix in PARQUET_SUFFIXES else ""
+        raise InputError(f"table {path} could not be read: {exc}{hint}") from exc
     raise InputError(f"table {path}: unknown format '{suffix}' (expected .parquet, .pq or .csv)")
 
 
@@ -49,10 +52,27 @@ def write_table(df: pd.DataFrame, path: str | Path, metadata: dict | None = None
         merged = dict(table.schema.metadata or {})
         merged[METADATA_KEY] = json.dumps(metadata, sort_keys=True).encode()
         table = table.replace_schema_metadata(merged)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
     return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path):
+    """A temporary sibling of `path` (same suffix) to write to: renamed onto `path` when the block
+    ends, removed when it fails (a full or read-only disk, an interrupt), so `path` is either the
+    finished file or absent. Temporaries left by a killed writer (kill -9) are removed first."""
+    path = Path(path)
+    for stale in path.parent.glob(f".{path.name}.tmp-*"):
+        stale.unlink(missing_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise
 
 
 def read_table_metadata(path: str | Path) -> dict:

@@ -67,6 +67,9 @@ def main(argv: list[str] | None = None) -> int:
     except ShockcalError as exc:
         print(f"shockcal {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:                                    # the machine's, not shockcal's: disk full, read-only
+        print(f"shockcal {args.command}: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

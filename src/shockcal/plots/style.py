@@ -12,7 +12,6 @@ velocities in m/s, times in microseconds, velocities in m/s. Tables keep the pap
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import matplotlib
@@ -22,6 +21,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+
+from shockcal.io import atomic_path  # noqa: E402
 
 COLORS = {
     "training": "#8c8c8c",
@@ -152,9 +153,8 @@ def save_figure(fig, out_stem: str | Path, formats=("png", "pdf"), dpi: int = 15
     paths = []
     for fmt in formats:
         path = out_stem.with_name(f"{out_stem.name}.{fmt}")
-        tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}.{fmt}")
-        fig.savefig(tmp, dpi=dpi, format=fmt)
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, format=fmt)
         paths.append(path)
     plt.close(fig)
     return paths
