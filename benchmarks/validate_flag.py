@@ -127,7 +127,7 @@ def main(argv=None) -> int:
     design = pd.read_csv(ref / "design.csv").iloc[: args.runs]
     tasks = [(shot, design.iloc[i: i + CHUNK], config) for shot in args.shots for i in range(0, args.runs, CHUNK)]
     print(f"{args.runs} design runs x {len(args.shots)} shots on {PROCESSES} processes "
-          f"(hydro {config['hydro']['cell_size_um']} um, {config['hydro']['end_time_us']} us)")
+          f"(hydro {config['hydro']['cell_size_um']} um, end time {config['hydro']['end_time_us']})")
     start = time.perf_counter()
     with Pool(PROCESSES) as pool:
         ours = pd.concat(pool.imap_unordered(simulate_chunk, tasks), ignore_index=True)

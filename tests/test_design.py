@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.design import latin_hypercube, load_design, shot_parameters, validate_shot_parameters
+from shockcal.design import chunk_fingerprints, latin_hypercube, load_design, shot_parameters, validate_shot_parameters
 from shockcal.errors import InputError
 
 
@@ -60,3 +60,13 @@ def test_non_positive_shot_velocity_is_rejected_before_running(paper_config):
     validate_shot_parameters(design, paper_config, "104S", "d.csv")  # 104S does not use V2
     with pytest.raises(InputError, match="run 2: impact velocity V2"):
         validate_shot_parameters(design, paper_config, "105S", "d.csv")
+
+
+def test_design_depends_on_inputs_and_seed_not_on_their_order(paper_config):
+    # the workflow's jobs read a key-sorted copy of the config; the Snakefile plans chunks on the
+    # config as written: both must see the same design (and the same chunk digests)
+    shuffled = {**paper_config, "inputs": dict(sorted(paper_config["inputs"].items()))}
+    a, b = latin_hypercube(paper_config, 30, seed=4), latin_hypercube(shuffled, 30, seed=4)
+    assert list(a.columns) == ["run", *paper_config["inputs"]]
+    pd.testing.assert_frame_equal(a, b[a.columns])
+    assert chunk_fingerprints(a, 10) == chunk_fingerprints(b, 10)

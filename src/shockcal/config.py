@@ -8,6 +8,7 @@ for the workflow is the repository root.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import yaml
@@ -19,6 +20,7 @@ SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
 # Johnson-Cook strength inputs shared by every shot (SPEC section 3), in Table IV units.
 STRENGTH_INPUTS = ("A", "B", "C", "n", "m")
+AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
 
 
 def load_config(path: str | Path) -> dict:
@@ -131,6 +133,21 @@ def shot_config(config: dict, shot: str) -> dict:
         return config["shots"][shot]
     except KeyError:
         raise ConfigError(f"unknown shot '{shot}'; the config defines {sorted(config['shots'])}") from None
+
+
+def end_time_us(config: dict, shot: dict) -> float:
+    """Simulated time of a run of `shot` (us): `hydro.end_time_us`, or with `auto` the latest time
+    the feature extractor can need. The free surface starts to move no later than target / c0 after
+    impact (the elastic precursor travels faster than the bulk sound speed c0 = sqrt(c1 / rho0));
+    the analysis window ends `window_after_arrival_us` later; AUTO_END_MARGIN_US is added. A run whose
+    window still reaches past its end fails in the extractor with a reason, never silently."""
+    requested = config["hydro"]["end_time_us"]
+    if requested != "auto":
+        return float(requested)
+    material = config["material"]
+    c0_cm_us = math.sqrt(material["eos"]["c1_Mbar"] / material["rho0_g_cc"])
+    window = shot["analysis"]["window_after_arrival_us"]
+    return shot["target_mm"] * 0.1 / c0_cm_us + window + AUTO_END_MARGIN_US
 
 
 def shot_inputs(config: dict, shot: str) -> list[str]:

@@ -24,13 +24,18 @@ log = logging.getLogger("shockcal.design")
 
 
 def latin_hypercube(config: dict, n_runs: int, seed: int) -> pd.DataFrame:
-    """A seeded Latin hypercube of `n_runs` points over the config's input box (scipy.stats.qmc)."""
+    """A seeded Latin hypercube of `n_runs` points over the config's input box (scipy.stats.qmc).
+
+    The hypercube's dimensions are the inputs in sorted order, so the design depends on the inputs
+    and the seed, not on the order the config lists them (the workflow's jobs read a key-sorted
+    copy of the config); the columns come back in config order.
+    """
     from scipy.stats import qmc
 
-    names = input_names(config)
+    names = sorted(input_names(config))
     lower, upper = input_bounds(config, names)
     unit = qmc.LatinHypercube(d=len(names), seed=np.random.default_rng(seed)).random(n_runs)
-    design = pd.DataFrame(qmc.scale(unit, lower, upper), columns=names)
+    design = pd.DataFrame(qmc.scale(unit, lower, upper), columns=names)[input_names(config)]
     design.insert(0, "run", np.arange(n_runs, dtype=np.int64))
     return design
 
@@ -133,12 +138,13 @@ def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:
     """A content digest of each chunk of `chunk_size` design rows.
 
     The workflow puts these in each simulate job's params, so a chunk reruns exactly when its own
-    rows change: appending runs to a design file adds chunks without touching finished ones.
+    rows change: appending runs to a design file adds chunks without touching finished ones, and
+    the same rows with their columns in another order change nothing.
     """
     import hashlib
 
     digests = []
     for start in range(0, len(design), chunk_size):
-        rows = design.iloc[start:start + chunk_size]
+        rows = design.iloc[start:start + chunk_size][sorted(design.columns)]    # the column order is no content
         digests.append(hashlib.sha256(pd.util.hash_pandas_object(rows, index=False).to_numpy().tobytes()).hexdigest()[:16])
     return digests

@@ -28,8 +28,9 @@ UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_r
          "t_us": "us", "v_m_s": "m/s"}
 
 
-def simulate_design(design: pd.DataFrame, config: dict, shot: str) -> pd.DataFrame:
-    """Simulate every row of `design` for `shot`; failures become rows with a reason."""
+def simulate_design(design: pd.DataFrame, config: dict, shot: str, end_us: float | None = None) -> pd.DataFrame:
+    """Simulate every row of `design` for `shot` to `end_us` (default: the config's end time for the
+    shot, `hydro.end_time_us`); failures become rows with a reason."""
     spec = shot_config(config, shot)
     inputs = shot_inputs(config, shot)
     rows = []
@@ -39,7 +40,7 @@ def simulate_design(design: pd.DataFrame, config: dict, shot: str) -> pd.DataFra
                "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
                "shear_modulus_GPa": params.shear_modulus_Mbar * MBAR_TO_GPA}
         try:
-            result = run_shot(params, spec, config)
+            result = run_shot(params, spec, config, end_us)
         except Exception as exc:  # a run must never kill the batch; the reason is kept
             log.exception("run %s of shot %s raised", row["run"], shot)
             rows.append({**row, "status": "failed", "reason": f"{type(exc).__name__}: {exc}",

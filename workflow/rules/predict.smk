@@ -61,9 +61,10 @@ rule run_set_simulate:
     params:
         physics=lambda w: physics_slice(config, w.shot),
         rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
+        end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
-        " --rows {params.rows} --out {output} > {log} 2>&1"
+        " --rows {params.rows} {params.end_time} --out {output} > {log} 2>&1"
 
 
 rule run_set_features:

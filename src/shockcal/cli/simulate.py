@@ -12,6 +12,8 @@ def register(subparsers) -> None:
     p.add_argument("--design", required=True, help="design table (CSV or Parquet; Table IV units; `run` kept)")
     p.add_argument("--rows", default=":", help="slice of design row positions, e.g. 0:25 (default: all)")
     p.add_argument("--out", required=True, help="output Parquet table (one row per run; see docs/hydro.md)")
+    p.add_argument("--end-time-us", type=float, default=None,
+                   help="simulate to this time (us) instead of hydro.end_time_us (e.g. the history figures' runs)")
     p.set_defaults(func=run)
 
 
@@ -33,6 +35,7 @@ def run(args) -> int:
 
     from shockcal.config import load_config, shot_config, shot_inputs
     from shockcal.design import load_design, validate_shot_parameters
+    from shockcal.errors import InputError
     from shockcal.io import write_table
     from shockcal.simulate import UNITS, simulate_design
 
@@ -41,7 +44,9 @@ def run(args) -> int:
     rows = parse_rows(args.rows)
     design = load_design(args.design, config, columns=shot_inputs(config, args.shot)).iloc[rows]
     validate_shot_parameters(design, config, args.shot, args.design)
-    table = simulate_design(design, config, args.shot)
+    if args.end_time_us is not None and args.end_time_us <= 0:
+        raise InputError(f"--end-time-us: {args.end_time_us} is not a positive time")
+    table = simulate_design(design, config, args.shot, args.end_time_us)
     units = {**UNITS, **{k: config["inputs"][k]["unit"] for k in shot_inputs(config, args.shot)}}
     write_table(table, args.out, {"table": "simulations", "shot": args.shot, "units": units,
                                   "hydro": config["hydro"], "material": config["material"]})

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from shockcal.config import end_time_us
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
 from shockcal.hydro.strength import flow_stress, hardening, radial_return, thermal_factor
 
@@ -218,14 +219,16 @@ class RunResult:
     energy_history: np.ndarray = field(default=None, repr=False)
 
 
-def run_shot(params, shot: dict, config: dict) -> RunResult:
-    """Simulate one shot. `params` is a shockcal.design.ShotParameters (Mbar, cm/us)."""
+def run_shot(params, shot: dict, config: dict, end_us: float | None = None) -> RunResult:
+    """Simulate one shot to `end_us` (default: `end_time_us(config, shot)`). `params` is a
+    shockcal.design.ShotParameters (Mbar, cm/us)."""
     material, hydro, eos = config["material"], config["hydro"], config["material"]["eos"]
     dx = hydro["cell_size_um"] * 1e-4
     nf = max(int(round(shot["flyer_mm"] * 0.1 / dx)), 1)
     nt = max(int(round(shot["target_mm"] * 0.1 / dx)), 1)
     dt_out = hydro["output_dt_ns"] * 1e-3
-    t_out = np.arange(int(round(hydro["end_time_us"] / dt_out)) + 1) * dt_out
+    end_us = end_time_us(config, shot) if end_us is None else end_us
+    t_out = np.arange(int(round(end_us / dt_out)) + 1) * dt_out
     start = time.perf_counter()
     v, energy, status, cell, t_fail, steps, max_rate, max_T, max_eps = _simulate(
         nf, nt, dx, params.velocity_cm_us, params.shear_modulus_Mbar, params.A, params.B, params.C, params.n,

@@ -1,0 +1,45 @@
+"""Write tests/data/end_time_reference.csv: the features of a fixed set of runs simulated to 4 us.
+
+The set: three seeded Latin-hypercube points per shot and two corners of the prior box where the
+free surface moves latest (small A, B, G and impact velocity; strong thermal softening). Made with
+the rate convention of issue 12 and `hydro.end_time_us: 4.0`; `tests/test_end_time.py` checks that
+`end_time_us: auto` reproduces these features within 0.05 m/s (and 0.5 ns).
+Run: python tests/data/make_end_time_reference.py
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from shockcal.config import load_config
+from shockcal.design import latin_hypercube
+from shockcal.features import features_table
+from shockcal.simulate import simulate_design
+
+REPO = Path(__file__).resolve().parents[2]
+OUT = Path(__file__).with_name("end_time_reference.csv")
+
+
+def reference_design(config: dict) -> pd.DataFrame:
+    """The fixed runs: 3 hypercube points (seed 12) and the two late-arrival corners."""
+    design = latin_hypercube(config, 3, seed=12)
+    low = {k: v["min"] for k, v in config["inputs"].items()}
+    softening = {**low, "m": config["inputs"]["m"]["min"], "C": config["inputs"]["C"]["max"],
+                 "n": config["inputs"]["n"]["max"]}
+    corners = pd.DataFrame([low, softening]).assign(run=[3, 4])
+    return pd.concat([design, corners[design.columns]], ignore_index=True)
+
+
+def features_at(config: dict, end_time_us) -> pd.DataFrame:
+    config = {**config, "hydro": {**config["hydro"], "end_time_us": end_time_us}}
+    design = reference_design(config)
+    tables = [features_table(simulate_design(design, config, shot), config, shot).assign(shot=shot)
+              for shot in config["shots"]]
+    return pd.concat(tables, ignore_index=True)
+
+
+if __name__ == "__main__":
+    table = features_at(load_config(REPO / "config" / "config.yaml"), 4.0)
+    table.to_csv(OUT, index=False, float_format="%.6f")
+    print(f"wrote {len(table)} rows to {OUT}")
