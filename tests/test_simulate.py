@@ -36,10 +36,10 @@ def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypa
     config, _ = coarse_config
     real = solver.run_shot
 
-    def flaky(params, shot, cfg):
+    def flaky(params, shot, cfg, end_us=None):
         if params.A == design["A"].iloc[1]:
             raise FloatingPointError("synthetic failure")
-        return real(params, shot, cfg)
+        return real(params, shot, cfg, end_us)
 
     design = latin_hypercube(config, 3, seed=2)
     monkeypatch.setattr("shockcal.simulate.run_shot", flaky)
