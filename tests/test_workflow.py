@@ -148,21 +148,10 @@ def test_added_shot_runs_only_its_simulations(study, tmp_path):
 
 
 def params_changed(*config_files) -> set[str]:
-    """Rules with a job a dry run of `all` would rerun because its own params changed. The design
-    job is left out (its file is taken as it is), so that a design rerun does not hide the params
-    reasons of everything downstream behind "input updated"."""
-    listed = snakemake("--list-rules", config_files=config_files).stdout.splitlines()
-    rules = {line.split()[0] for line in listed if line and not line[0].isspace()}   # names; docstrings indented
-    allowed = sorted(rules - {"design", "Using", "Config", "Building"})
-    out = snakemake("all", "--dry-run", "--rerun-triggers", "params", "--allowed-rules", *allowed,
-                    config_files=config_files).stdout
-    changed, rule = set(), None
-    for line in out.splitlines():
-        if line.startswith(("rule ", "localrule ")):
-            rule = line.split()[1].rstrip(":")
-        elif line.strip().startswith("reason:") and "Params have changed" in line:
-            changed.add(rule)
-    return changed
+    """Rules with an output whose recorded params differ from what the config gives now
+    (`snakemake --summary`: output, date, rule, log, status, plan)."""
+    rows = [line.split("\t") for line in snakemake("--summary", config_files=config_files).stdout.splitlines()[1:]]
+    return {row[2] for row in rows if len(row) > 4 and row[4] == "params changed"}
 
 
 def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
@@ -218,6 +207,7 @@ def finished_outputs(log: str) -> set[str]:
     return finished
 
 
+@pytest.mark.slow   # 30-40 s; the stale lock of kill -9 is checked in the fast suite
 def test_a_second_snakemake_on_the_directory_is_refused(tmp_path):
     """While a study runs, a second snakemake on the same directory stops at the lock, and the first
     is not disturbed."""
@@ -236,7 +226,8 @@ def test_a_second_snakemake_on_the_directory_is_refused(tmp_path):
         snakemake("--unlock", config_files=[config])
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+@pytest.mark.parametrize("sig", [pytest.param(signal.SIGINT, marks=pytest.mark.slow), signal.SIGKILL],
+                         ids=["ctrl-c", "kill-9"])   # ctrl-c is the milder case: `make test-slow`
 def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path, sig):
     """Ctrl-C or kill -9 in the middle of the fan-out; the rerun (after `--unlock` when kill -9 left
     the lock behind) recomputes no chunk snakemake reported finished, and gives the same tables as

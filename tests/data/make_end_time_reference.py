@@ -31,9 +31,12 @@ def reference_design(config: dict) -> pd.DataFrame:
     return pd.concat([design, corners[design.columns]], ignore_index=True)
 
 
-def features_at(config: dict, end_time_us) -> pd.DataFrame:
+def features_at(config: dict, end_time_us, runs=None) -> pd.DataFrame:
+    """Features of the reference runs (or of `runs` among them) simulated to `end_time_us`."""
     config = {**config, "hydro": {**config["hydro"], "end_time_us": end_time_us}}
     design = reference_design(config)
+    if runs is not None:
+        design = design[design["run"].isin(runs)]
     tables = [features_table(simulate_design(design, config, shot), config, shot).assign(shot=shot)
               for shot in config["shots"]]
     return pd.concat(tables, ignore_index=True)
