@@ -21,10 +21,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.cli.features import record_features
 from shockcal.config import load_config
 from shockcal.errors import InputError
-from shockcal.features import COLUMNS, features_table
+from shockcal.features import COLUMNS, features_table, record_features
 from shockcal.reference import require_reference_dir
 from shockcal.simulate import simulate_design
 

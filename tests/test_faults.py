@@ -18,11 +18,11 @@ import yaml
 
 from shockcal.calibration import calibrate
 from shockcal.cli import main, parse_pairs
-from shockcal.cli.features import check_failures
 from shockcal.cli.simulate import parse_rows
 from shockcal.config import load_config, validate_config
 from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
 from shockcal.errors import ConfigError, InputError, ShockcalError
+from shockcal.features import check_failures
 from shockcal.io import atomic_path, read_table, write_table
 from shockcal.records import OPT_OUT, read_record
 

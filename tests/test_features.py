@@ -9,9 +9,8 @@ import pandas as pd
 import pytest
 from scipy.stats import norm
 
-from shockcal.cli.features import record_features
 from shockcal.errors import InputError
-from shockcal.features import COLUMNS, extract_features, features_table
+from shockcal.features import COLUMNS, extract_features, features_table, record_features
 from shockcal.records import read_record
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "al5083"   # the shipped records and published features

@@ -34,15 +34,19 @@
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import optimize, stats
 
+from shockcal.errors import InputError, ShockcalError
+
 if TYPE_CHECKING:
     import pandas as pd
 
+log = logging.getLogger("shockcal.features")
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
 ARRIVAL_FRACTION = 0.02
@@ -198,3 +202,50 @@ def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
+
+
+def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:
+    """The ten features of a measured record, with the shot's analysis settings; InputError naming the
+    record when it has none."""
+    from shockcal.records import read_record
+
+    t, v = read_record(path, _column(time_column), _column(velocity_column))
+    try:
+        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"])
+    except FeatureError as exc:
+        raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
+
+
+def _column(value):
+    return int(value) if isinstance(value, str) and value.isdigit() else value
+
+
+def check_failures(table, max_fraction: float, shot: str) -> None:
+    """Log the excluded count; stop when more than `max_fraction` of the runs failed."""
+    failed = table[table["status"] != "ok"]
+    if failed.empty:
+        log.info("shot %s: all %d runs have features", shot, len(table))
+        return
+    log.warning("shot %s: %d of %d runs failed and are excluded downstream", shot, len(failed), len(table))
+    if len(failed) > max_fraction * len(table):
+        worst = "\n".join(f"  run {r.run}: {r.reason}" for r in failed.head(10).itertuples())
+        raise ShockcalError(f"shot {shot}: {len(failed)} of {len(table)} runs failed, more than the allowed "
+                            f"{max_fraction:.0%} (simulate.max_failed_fraction); the first:\n{worst}")
+
+
+def observed_table(config: dict):
+    """The measured features of every shot (one row per shot: shot, source, the ten features), from
+    the VISAR records through this extractor (`observed.source: records`) or the published values."""
+    import pandas as pd
+
+    observed = config["observed"]
+    rows = []
+    for shot in config["shots"]:      # load_config checked that every shot has its source's entry
+        if observed["source"] == "records":
+            spec = observed["records"][shot]
+            rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
+                         **record_features(config, shot, spec["path"], spec["time_column"], spec["velocity_column"])})
+        else:
+            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
+                         **observed["features"][shot]})
+    return pd.DataFrame(rows)[["shot", "source", *COLUMNS]]

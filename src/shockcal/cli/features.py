@@ -32,6 +32,7 @@ def run(args) -> int:
     import pandas as pd
 
     from shockcal.config import load_config, shot_config
+    from shockcal.features import check_failures, record_features
     from shockcal.io import read_table, write_table
 
     config = load_config(args.config)
@@ -51,58 +52,13 @@ def run(args) -> int:
     return 0
 
 
-def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:
-    """The ten features of a measured record, with the shot's analysis settings; InputError naming the
-    record when it has none."""
-    from shockcal.errors import InputError
-    from shockcal.features import FeatureError, extract_features
-    from shockcal.records import read_record
-
-    t, v = read_record(path, _column(time_column), _column(velocity_column))
-    try:
-        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"])
-    except FeatureError as exc:
-        raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
-
-
-def _column(value):
-    return int(value) if isinstance(value, str) and value.isdigit() else value
-
-
-def check_failures(table, max_fraction: float, shot: str) -> None:
-    """Log the excluded count; stop when more than `max_fraction` of the runs failed."""
-    from shockcal.errors import ShockcalError
-
-    failed = table[table["status"] != "ok"]
-    if failed.empty:
-        log.info("shot %s: all %d runs have features", shot, len(table))
-        return
-    log.warning("shot %s: %d of %d runs failed and are excluded downstream", shot, len(failed), len(table))
-    if len(failed) > max_fraction * len(table):
-        worst = "\n".join(f"  run {r.run}: {r.reason}" for r in failed.head(10).itertuples())
-        raise ShockcalError(f"shot {shot}: {len(failed)} of {len(table)} runs failed, more than the allowed "
-                            f"{max_fraction:.0%} (simulate.max_failed_fraction); the first:\n{worst}")
-
-
 def run_observed(args) -> int:
-    import pandas as pd
-
     from shockcal.config import load_config
-    from shockcal.features import COLUMNS
+    from shockcal.features import observed_table
     from shockcal.io import write_table
 
     config = load_config(args.config)
-    observed = config["observed"]
-    rows = []
-    for shot in config["shots"]:      # load_config checked that every shot has its source's entry
-        if observed["source"] == "records":
-            spec = observed["records"][shot]
-            rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
-                         **record_features(config, shot, spec["path"], spec["time_column"], spec["velocity_column"])})
-        else:
-            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
-                         **observed["features"][shot]})
-    table = pd.DataFrame(rows)[["shot", "source", *COLUMNS]]
+    table = observed_table(config)
     write_table(table, args.out, {"table": "observed features", "units": UNITS})
     log.info("observed features:\n%s", table.drop(columns="source").to_string(index=False))
     return 0
