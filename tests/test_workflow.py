@@ -186,6 +186,23 @@ def test_deleted_intermediates_rerun_only_their_dependents(study):
     assert pending_jobs(config) == {}
 
 
+def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_path):
+    """A fourth shot as a user adds one: its own impact-velocity input (a new design column, given in
+    a design file) and its record. Only its chunks are simulated; the other shots' are untouched."""
+    results, config = study
+    quick = load_config(REPO / "config" / "config.yaml")
+    design = pd.read_parquet(results / "design.parquet")
+    box = quick["inputs"]["V3"]
+    design["V4"] = np.random.default_rng(1).uniform(box["min"], box["max"], len(design))
+    grown = tmp_path / "design.parquet"
+    design.to_parquet(grown)
+    shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4")
+    more = overlay(tmp_path / "shot.yaml", design={"file": str(grown)}, inputs={"V4": box},
+                   shots={"107S": shot}, observed={"records": {"107S": dict(quick["observed"]["records"]["106S"])}})
+    jobs = pending_jobs(config, more)
+    assert jobs["simulate"] == 4 and jobs["features"] == 1, jobs   # the 4 chunks of 107S, its features
+
+
 def test_bad_config_is_rejected_before_any_job(tmp_path):
     bad = overlay(tmp_path / "bad.yaml", simulate={"chunk_size": 0})
     done = snakemake("all", "--dry-run", config_files=[bad], check=False)

@@ -4,6 +4,7 @@ import os
 
 import yaml
 
+from shockcal.config import shot_inputs
 from shockcal.design import chunk_fingerprints, planned_design
 from shockcal.workflow import chunk_count, chunk_rows, export_to_jobs, physics_slice, write_if_changed
 
@@ -17,8 +18,13 @@ write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
 export_to_jobs(EFFECTIVE_CONFIG)
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
-CHUNK_DIGESTS = chunk_fingerprints(planned_design(config), CHUNK_SIZE)
-CHUNKS = list(range(len(CHUNK_DIGESTS)))
+# per shot, over the run ids and the columns that shot reads: a column added for a new shot (its
+# impact velocity) leaves every other shot's chunks alone
+_PLANNED_DESIGN = planned_design(config)
+CHUNK_DIGESTS = {
+    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_inputs(config, shot)]], CHUNK_SIZE) for shot in SHOTS
+}
+CHUNKS = list(range(chunk_count(len(_PLANNED_DESIGN), CHUNK_SIZE)))
 
 LOGS = f"{RESULTS}/logs"
 BENCHMARKS = f"{RESULTS}/benchmarks"
