@@ -138,3 +138,15 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
     mean, cov = Emulator.load(tmp_path / "emu").predict({k: new[k].to_numpy() for k in new.columns}, ["105S"])
     row = table[(table["run"] == 103) & (table["shot"] == "105S") & (table["feature"] == "v_slope1")].iloc[0]
     assert row["mean"] == pytest.approx(mean[3, 2]) and row["sd"] == pytest.approx(np.sqrt(cov[3, 2, 2]))
+
+
+def test_same_seed_gives_the_same_emulator_and_another_seed_another_fit_subset():
+    # the fit subset (max_fit_runs < runs), the GP starts and the K-fold all come from settings.seed
+    X, Y, lower, upper = _problem(n=40)
+    fit = lambda seed: PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=2, cv_folds=4, max_fit_runs=30,  # noqa: E731
+                                                                     seed=seed))
+    a, b, c = fit(5), fit(5), fit(6)
+    for name, value in a.to_arrays().items():
+        np.testing.assert_array_equal(value, b.to_arrays()[name], err_msg=name)
+    assert a.to_json() == b.to_json()
+    assert a.to_json() != c.to_json()
