@@ -210,6 +210,30 @@ def test_bad_config_is_rejected_before_any_job(tmp_path):
     assert "simulate.chunk_size" in done.stdout + done.stderr
 
 
+def comparable_tables(results: Path) -> dict[str, pd.DataFrame]:
+    """Every Parquet and CSV table of a results directory by relative path, without wall times."""
+    tables = {}
+    for path in sorted(results.rglob("*")):
+        if path.suffix in (".parquet", ".csv") and "benchmarks" not in path.parts:
+            table = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+            tables[path.relative_to(results).as_posix()] = table.drop(columns=["wall_time_s"], errors="ignore")
+    return tables
+
+
+@pytest.mark.slow   # a second quick study, about 3 min
+def test_two_clean_runs_give_identical_tables_and_emulator(study, tmp_path):
+    results, _ = study
+    again = tmp_path / "results"
+    snakemake("all", "--cores", "2", config_files=[overlay(tmp_path / "again.yaml", study={"results_dir": str(again)})])
+    ours, theirs = comparable_tables(again), comparable_tables(results)
+    assert ours.keys() == theirs.keys() and len(ours) > 30, sorted(set(ours) ^ set(theirs))
+    for name, table in ours.items():
+        pd.testing.assert_frame_equal(table, theirs[name], check_exact=True, obj=name)
+    assert (again / "emulator" / "emulator.json").read_text() == (results / "emulator" / "emulator.json").read_text()
+    with np.load(again / "emulator" / "emulator.npz") as a, np.load(results / "emulator" / "emulator.npz") as b:
+        assert a.files == b.files and all(np.array_equal(a[k], b[k]) for k in a.files)
+
+
 def finished_outputs(log: str) -> set[str]:
     """Output files of the jobs snakemake reported finished in its log."""
     outputs, finished, current = {}, set(), []
