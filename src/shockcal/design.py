@@ -19,6 +19,7 @@ from shockcal.config import STRENGTH_INPUTS, input_bounds, input_names, shot_con
 from shockcal.errors import InputError
 from shockcal.io import read_table, require_columns
 from shockcal.plausibility import range_problem
+from shockcal.seeds import stream_seed
 
 log = logging.getLogger("shockcal.design")
 
@@ -131,7 +132,7 @@ def planned_design(config: dict) -> pd.DataFrame:
     """The study's design as `shockcal design` writes it: the config's design file, or its LHS."""
     if config["design"]["file"]:
         return load_design(config["design"]["file"], config)
-    return latin_hypercube(config, config["design"]["n_runs"], config["study"]["seed"])
+    return latin_hypercube(config, config["design"]["n_runs"], stream_seed(config["study"]["seed"], "design"))
 
 
 def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:
