@@ -137,22 +137,35 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     samples = np.interp((np.arange(n_samples) + 0.5) / n_samples, y[rising], tw[rising])
     mixture = fit_mixture(samples, n_components)
     cutoff = arrival + cutoff_after_arrival_us
-    early = mixture.means + 2 * mixture.sds < cutoff
+    early = split_early(mixture, cutoff)
+    features = feature_values(t, v, tw, y, mixture, early)
+    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
+
+
+def split_early(mixture: Mixture, cutoff_us: float) -> np.ndarray:
+    """Mask of the early (elastic) components: mu + 2 sigma before the cut-off. A single wave puts
+    every component on one side; then the latest (resp. earliest) one is moved to the other side."""
+    early = mixture.means + 2 * mixture.sds < cutoff_us
     if early.all():          # one wave only (elastic, large A): its latest component is the late mixture
         early[np.argmax(mixture.means)] = False
     elif not early.any():    # the precursor merges with the plastic rise: its earliest component is early
         early[np.argmin(mixture.means)] = True
+    return early
+
+
+def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarray) -> dict:
+    """The ten feature values (times us, velocities m/s) from the mixture split into early and late."""
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
     elastic = early_mix.quantile(0.99)
     slope1 = max(late_mix.quantile(0.1), elastic)     # a single wave's broad last component can reach back
     times = {"jumpoff": early_mix.quantile(0.01), "elastic": elastic,
              "slope1": slope1, "slope2": max(late_mix.quantile(0.9), slope1),
-             "plastic": float(tw[np.argmax(y >= PLASTIC_LEVEL)])}
+             "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
     features = {}
     for name in FEATURES:
         features[f"t_{name}"] = float(times[name])
         features[f"v_{name}"] = float(np.interp(times[name], t, v))
-    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
+    return features
 
 
 def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:

@@ -1,0 +1,55 @@
+"""Our hydrocode and extractor against the paper's FLAG features (../shared/data/al5083, runs 0-499).
+
+`make validate` compares all 500 runs of every shot (docs/hydro.md); these tests keep two of its
+findings from regressing at a test's cost: the single-wave traces of 104S, where the early/late
+split decides what "elastic plateau" means, and the goals met on a fixed sample of the design.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from shockcal.features import features_table
+from shockcal.simulate import simulate_design
+
+# The ten 104S runs (A 390-950 MPa: one merged wave) where a cut-off 80 ns after arrival put a broad
+# second component into the elastic mixture: v_elastic 16-33 m/s above FLAG's (RMSE 22 m/s), v_slope1 13-28.
+SINGLE_WAVE_RUNS_104S = [202, 248, 212, 354, 418, 421, 292, 466, 289, 52]
+SAMPLE_STRIDE = 25      # runs 0, 25, ..., 475 of each shot for the slow check
+RMSE_GOALS_M_S = {"v_elastic": 1.5, "v_plastic": 2.5}   # issue 12's goals met in every shot
+RISE_BIAS_GOAL_NS = 15.0
+
+
+def errors_against_flag(reference_data, config, shot, runs) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(our features, FLAG's) for the given design runs of one shot, indexed by run."""
+    design = pd.read_csv(reference_data / "design.csv")
+    flag = pd.read_csv(reference_data / f"flag_features_{shot}.csv").set_index("run")
+    traces = simulate_design(design[design["run"].isin(runs)], config, shot)
+    ours = features_table(traces, config, shot).set_index("run")
+    assert (ours["status"] == "ok").all(), ours.loc[ours["status"] != "ok", "reason"]
+    return ours, flag.loc[ours.index]
+
+
+def rmse(a, b) -> float:
+    return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
+
+
+def test_single_wave_traces_read_the_elastic_plateau_like_flag(reference_data, paper_config):
+    ours, flag = errors_against_flag(reference_data, paper_config, "104S", SINGLE_WAVE_RUNS_104S)
+    error = ours["v_elastic"] - flag["v_elastic"]
+    assert rmse(ours["v_elastic"], flag["v_elastic"]) < 8.0, error.round(1).to_dict()   # measured 6.6
+    assert error.abs().max() < 15.0, error.round(1).to_dict()                          # measured 12.7
+    # the first slope point follows (measured RMSE 4.3 m/s; 18 with the late cut-off)
+    assert rmse(ours["v_slope1"], flag["v_slope1"]) < 6.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("shot", ["104S", "105S", "106S"])
+def test_goals_met_on_a_fixed_sample_of_the_design(reference_data, paper_config, shot):
+    ours, flag = errors_against_flag(reference_data, paper_config, shot, list(range(0, 500, SAMPLE_STRIDE)))
+    for feature, goal in RMSE_GOALS_M_S.items():
+        assert rmse(ours[feature], flag[feature]) <= goal, feature
+    rise_bias_ns = 1e3 * np.mean((ours["t_slope2"] - ours["t_slope1"]) - (flag["t_slope2"] - flag["t_slope1"]))
+    assert abs(rise_bias_ns) <= RISE_BIAS_GOAL_NS
