@@ -10,7 +10,15 @@ import pytest
 from scipy.stats import norm
 
 from shockcal.errors import InputError
-from shockcal.features import COLUMNS, extract_features, features_table, record_features
+from shockcal.features import (
+    COLUMNS,
+    Mixture,
+    extract_features,
+    feature_values,
+    features_table,
+    record_features,
+    split_early,
+)
 from shockcal.records import read_record
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "al5083"   # the shipped records and published features
@@ -104,6 +112,24 @@ def test_a_single_wave_still_has_ordered_features(settings):
     assert f["v_slope2"] <= f["v_plastic"] <= 200.0 and f["v_plastic"] >= 0.99 * 200.0
     assert f["t_elastic"] <= f["t_slope1"] and f["v_elastic"] <= f["v_slope1"]   # on the top, as FLAG's
     assert f["v_elastic"] >= 0.9 * 200.0
+
+
+def test_a_precursor_without_a_component_of_its_own_is_read_inside_the_elastic_part():
+    # A 7 m/s precursor 0.25 us ahead of a 460 m/s plastic wave (A near 50 MPa in 106S). When EM
+    # gives the precursor no component before the cut-off, the early stand-in is the broad earliest
+    # component: its 0.99 quantile lay on the plastic plateau (v_elastic = v_plastic, design run 106
+    # of the study) and its 0.01 quantile before the window. They are kept in [window start, cut-off].
+    v = 7.0 * norm.cdf((T - 1.0) / 0.003) + 460.0 * norm.cdf((T - 1.25) / 0.003)
+    window = (T >= 0.95) & (T <= 1.9)
+    cdf = (v[window] - v[window].min()) / np.ptp(v[window])
+    mixture = Mixture(np.array([0.02, 0.49, 0.49]), np.array([1.1, 1.249, 1.251]), np.array([0.15, 0.002, 0.002]))
+    cutoff = 1.04
+    early = split_early(mixture, cutoff)
+    assert early.tolist() == [True, False, False]      # the fallback: no component ends before the cut-off
+    features = feature_values(T, v, T[window], cdf, mixture, early, cutoff)
+    assert features["t_elastic"] == cutoff and features["v_elastic"] == pytest.approx(7.0, abs=0.01)
+    assert features["t_jumpoff"] == pytest.approx(0.95)
+    assert 7.0 < features["v_slope1"] < features["v_slope2"] < 467.0
 
 
 @pytest.mark.parametrize("noise_sd", [0.0, 1.0])

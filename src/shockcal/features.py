@@ -138,7 +138,7 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     mixture = fit_mixture(samples, n_components)
     cutoff = arrival + cutoff_after_arrival_us
     early = split_early(mixture, cutoff)
-    features = feature_values(t, v, tw, y, mixture, early)
+    features = feature_values(t, v, tw, y, mixture, early, cutoff)
     return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
 
 
@@ -153,12 +153,20 @@ def split_early(mixture: Mixture, cutoff_us: float) -> np.ndarray:
     return early
 
 
-def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarray) -> dict:
-    """The ten feature values (times us, velocities m/s) from the mixture split into early and late."""
+def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarray, cutoff_us: float) -> dict:
+    """The ten feature values (times us, velocities m/s) from the mixture split into early and late.
+
+    When no component lies before the cut-off (a precursor too small for EM to give it a component of
+    its own: a few m/s ahead of the plastic wave at small A), the stand-in early component is broad,
+    and its quantiles are kept inside the elastic part of the window: jump-off not before the window
+    starts, elastic plateau not after the cut-off (unclamped, they fell 0.3 us before the arrival and
+    on the plastic plateau: v_elastic = v_plastic)."""
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
-    elastic = early_mix.quantile(0.99)
+    jumpoff, elastic = early_mix.quantile(0.01), early_mix.quantile(0.99)
+    if not np.any(early_mix.means + 2 * early_mix.sds < cutoff_us):
+        jumpoff, elastic = max(jumpoff, t_window[0]), min(elastic, cutoff_us)
     slope1 = max(late_mix.quantile(0.1), elastic)     # a single wave's broad last component can reach back
-    times = {"jumpoff": early_mix.quantile(0.01), "elastic": elastic,
+    times = {"jumpoff": jumpoff, "elastic": elastic,
              "slope1": slope1, "slope2": max(late_mix.quantile(0.9), slope1),
              "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
     features = {}
