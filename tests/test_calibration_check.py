@@ -104,6 +104,46 @@ def test_synthetic_truth_table_and_binomial_band(small_config):
     assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
 
 
+def test_synthetic_truth_in_batches_equals_one_run(small_config):
+    # each trial has its own random stream: the workflow's batches of trials are independent jobs
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    whole = synthetic_truth(emu, ["toy"], small_config, trials=3, seed=4, n_live=100, n_eff=300)
+    batches = [synthetic_truth(emu, ["toy"], small_config, trials=range(*r), seed=4, n_live=100, n_eff=300)
+               for r in [(2, 3), (0, 2)]]
+    merged = pd.concat(batches).sort_values("trial", kind="stable").reset_index(drop=True)
+    pd.testing.assert_frame_equal(merged, whole)
+    assert whole["trial"].tolist() == [0, 0, 0, 1, 1, 1, 2, 2, 2]
+
+
+def test_hydro_truth_needs_a_usable_run_per_trial(small_config):
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    truths, _ = _toy_hydro_truths(emu, small_config, n_runs=5)     # 3 usable runs
+    with pytest.raises(InputError, match="trial 3 needs hydrocode run number 4, but only 3"):
+        synthetic_truth(emu, ["toy"], small_config, trials=range(2, 4), seed=4, truths=truths)
+
+
+def test_coverage_command_merges_batches_and_rejects_a_repeated_trial(tmp_path, capsys):
+    from shockcal.cli import main
+    from shockcal.io import read_table
+
+    def batch(trials, name):
+        rows = [{"trial": t, "parameter": p, "truth": 0.5, "q05": 0.0, "q95": 1.0 if t % 5 else 0.1,
+                 "inside": bool(t % 5), "ess": 900.0} for t in trials for p in ("A", "lambda_y")]
+        path = tmp_path / name
+        pd.DataFrame(rows).to_parquet(path)
+        return str(path)
+
+    first, second = batch(range(10, 20), "b1.parquet"), batch(range(10), "b0.parquet")
+    assert main(["coverage", "--trials", first, second, "--out", str(tmp_path / "all.parquet")]) == 0
+    merged = read_table(tmp_path / "all.parquet")
+    assert merged["trial"].tolist() == sorted(merged["trial"].tolist()) and merged["trial"].nunique() == 20
+    assert coverage_table(merged)["coverage90"].tolist() == [0.8, 0.8]
+    again = batch(range(5, 8), "b2.parquet")
+    assert main(["coverage", "--trials", second, again, "--out", str(tmp_path / "bad.parquet")]) == 2
+    assert "trial 5 is in more than one" in capsys.readouterr().err
+    assert not (tmp_path / "bad.parquet").exists()
+
+
 @pytest.mark.slow
 def test_synthetic_truth_coverage_is_near_nominal(small_config):
     # A two-input shot and 40 trials (about 5 min: nautilus costs a few seconds per run even on a toy).
@@ -140,7 +180,7 @@ def _toy_hydro_truths(emu, config, n_runs=60):
 def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
     truths, theta = _toy_hydro_truths(emu, small_config)
-    draws = list(truths.draws(["A", "n"], ["toy"]))
+    draws = truths.table(["A", "n"], ["toy"])
     assert len(draws) == 58
     np.testing.assert_array_equal(draws[0][0], theta[2])
     assert draws[0][1].shape == (4,)

@@ -46,9 +46,9 @@ def overlay(path: Path, **sections) -> Path:
     return path
 
 
-def pending_jobs(*config_files) -> dict[str, int]:
-    """Rule -> number of jobs a dry run of `all` would execute (empty when nothing is to be done)."""
-    out = snakemake("all", "--dry-run", config_files=config_files).stdout
+def pending_jobs(*config_files, target="all") -> dict[str, int]:
+    """Rule -> number of jobs a dry run of `target` would execute (empty when nothing is to be done)."""
+    out = snakemake(target, "--dry-run", config_files=config_files).stdout
     if "Job stats:" not in out:
         assert "Nothing to be done" in out, out[-2000:]
         return {}
@@ -166,6 +166,13 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
     flagged = params_changed(config, fixed, reseeded) - params_changed(config, fixed)
     histories = {f"figure_fig{n}_history_{shot}" for n, shot in [(11, "104S"), (12, "105S"), (13, "106S")]}
     assert flagged == {"emulator", "calibrate", "predict_design", *histories}, flagged
+
+
+def test_coverage_checks_fan_out_in_batches_of_trials(study):
+    # quick.yaml: 4 trials per check, 2 per job -> 2 batch jobs per truth, one merge each
+    jobs = pending_jobs(study[1], target="check")
+    assert jobs["calibration_check_batch"] == 4 and jobs["coverage"] == 2, jobs
+    assert "emulator" not in jobs and "simulate" not in jobs, jobs
 
 
 def test_deleted_intermediates_rerun_only_their_dependents(study):

@@ -203,23 +203,33 @@ def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str
     return samples, summary, info
 
 
-def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truths=None, **overrides) -> pd.DataFrame:
+def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=None, **overrides) -> pd.DataFrame:
     """Calibrate on synthetic truth with a known theta; one row per trial and parameter.
 
-    Each trial draws lambda_y from its prior and takes theta and noise-free features either from the
-    emulator (theta uniform on the box, features from its predictive distribution at theta) or, when
-    `truths` is given, from hydrocode runs (`HydroTruths`: theta of each run and its extracted
-    features). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is added and
-    the features are calibrated (`overrides` as in `calibrate`). Columns: trial, parameter, truth,
-    q05, q95, inside (the 90% interval holds the truth), ess (the trial's Kish ESS).
+    `trials` is a count or the trial numbers to run (a range): each trial draws from its own random
+    stream (child `trial` of `seed`), so a check split into batches of trials (the workflow's jobs)
+    gives the same rows as one run. A trial draws lambda_y from its prior and takes theta and
+    noise-free features either from the emulator (theta uniform on the box, features from its
+    predictive distribution at theta) or, when `truths` is given, from hydrocode run number `trial`
+    among the usable ones (`HydroTruths`). Observation noise of sd = sd_fraction / sqrt(lambda_y) of
+    each feature is added and the features are calibrated (`overrides` as in `calibrate`). Columns:
+    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS).
     """
-    rng = np.random.default_rng(seed)
+    trial_ids = range(trials) if isinstance(trials, int) else trials
     names = emulator.required_inputs(shots)
     sd_fraction = config["observed"]["sd_fraction"]
-    draw_truth = _emulator_truth(emulator, shots, names, rng) if truths is None else truths.draws(names, shots)
+    hydro_draws = None if truths is None else truths.table(names, shots)
+    if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
+        raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
+                         f"but only {len(hydro_draws)} truth runs are usable")
     rows = []
-    for trial in range(trials):
-        theta, lam, y = _noisy_truth(draw_truth, sd_fraction, rng)
+    for trial in trial_ids:
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
+        if hydro_draws is None:
+            theta, eta = _emulator_truth(emulator, shots, names, rng)
+        else:
+            theta, eta = hydro_draws[trial]
+        lam, y = _noisy_features(eta, sd_fraction, rng, trial)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
         _, summary, _ = calibrate(emulator, shots, observed, config, source=f"synthetic trial {trial}",
                                   seed=int(rng.integers(2**31)), **overrides)
@@ -228,31 +238,30 @@ def synthetic_truth(emulator, shots, config: dict, trials: int, seed: int, truth
             q05, q95 = summary.loc[name, ["q05", "q95"]]
             rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
                          "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"]})
-        log.info("synthetic trial %d/%d done", trial + 1, trials)
+        log.info("synthetic trial %d done (%d of %d)", trial, len(rows) // (len(names) + 1), len(trial_ids))
     return pd.DataFrame(rows)
 
 
-def _noisy_truth(draw_truth, sd_fraction, rng):
-    """(theta, lambda_y, pseudo-measured features): the next truth with lambda_y from its prior and
-    noise of sd = sd_fraction / sqrt(lambda_y) of each feature. A draw with a non-positive feature
-    (no measurement reports one) is replaced by the next truth."""
-    for theta, eta in draw_truth:
+def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
+    """(lambda_y, pseudo-measured features): lambda_y from its prior and noise of sd = sd_fraction /
+    sqrt(lambda_y) of each feature. No measurement reports a non-positive feature: such a draw is
+    drawn again (the features are conditioned on being positive)."""
+    for _ in range(attempts):
         lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1])
         y = eta + sd_fraction * np.abs(eta) / np.sqrt(lam) * rng.normal(size=eta.shape)
         if np.all(y > 0):
-            return theta, lam, y
-        log.info("synthetic truth with a non-positive feature: replaced by the next draw")
-    raise InputError("synthetic truth: no draws left for the requested number of trials")
+            return lam, y
+    raise InputError(f"synthetic trial {trial}: {attempts} noise draws all gave a non-positive feature "
+                     f"(noise-free features {np.round(eta, 3).tolist()})")
 
 
 def _emulator_truth(emulator, shots, names, rng):
-    """Endless (theta, features): theta uniform on the box, features from the emulator's predictive
+    """(theta, features): theta uniform on the box, features from the emulator's predictive
     distribution at theta."""
     lower, upper = emulator.input_bounds(names)
-    while True:
-        theta = rng.uniform(lower, upper)
-        mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
-        yield theta, rng.multivariate_normal(mean[0], cov[0])
+    theta = rng.uniform(lower, upper)
+    mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
+    return theta, rng.multivariate_normal(mean[0], cov[0])
 
 
 @dataclass
@@ -262,17 +271,16 @@ class HydroTruths:
     design: pd.DataFrame
     features: dict            # shot -> features table (run, status, feature columns)
 
-    def draws(self, names, shots):
-        """(theta, features) of each run, in run order, with every shot's features ok and positive."""
+    def table(self, names, shots) -> list:
+        """(theta, features) of each usable run (every shot's features ok and positive), in run order."""
         table = self.design.set_index("run")
         for shot in shots:
             ok = self.features[shot].query("status == 'ok'").set_index("run")
             table = table.join(ok[CALIBRATION_FEATURES].add_prefix(f"{shot}:"), how="inner")
         columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES]
-        usable = table[(table[columns] > 0).all(axis=1)]
+        usable = table[(table[columns] > 0).all(axis=1)].sort_index()
         log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable), len(self.design))
-        for _, row in usable.iterrows():
-            yield row[names].to_numpy(float), row[columns].to_numpy(float)
+        return list(zip(usable[names].to_numpy(float), usable[columns].to_numpy(float)))
 
 
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
@@ -287,10 +295,11 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
-def coverage_check(emulator, shots, config: dict, trials: int | None = None,
+def coverage_check(emulator, shots, config: dict, trials: int | range | None = None,
                    truths: HydroTruths | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The configured synthetic-truth check (calibration.check), on emulator or hydrocode truth:
-    per-trial table and coverage per parameter."""
+    per-trial table and coverage per parameter. `trials`: a count or the trial numbers of one batch
+    (default: all `calibration.check.trials`)."""
     check = config["calibration"]["check"]
     truth = "emulator" if truths is None else "hydrocode"
     table = synthetic_truth(emulator, shots, config, trials or check["trials"],

@@ -13,10 +13,12 @@ def write_if_changed(path, text: str) -> None:
         path.write_text(text)
 
 
-def chunk_rows(chunk, chunk_size: int) -> str:
-    """The design-row slice of one chunk, as `shockcal simulate --rows` takes it."""
+def chunk_rows(chunk, chunk_size: int, total: int | None = None) -> str:
+    """The slice START:STOP of one chunk (design rows for `shockcal simulate --rows`, trials for
+    `shockcal calibrate-check --trial-range`), cut at `total` when given."""
     start = int(chunk) * chunk_size
-    return f"{start}:{start + chunk_size}"
+    stop = start + chunk_size if total is None else min(start + chunk_size, total)
+    return f"{start}:{stop}"
 
 
 def chunk_count(n_runs: int, chunk_size: int) -> int:

@@ -29,15 +29,36 @@ rule calibrate:
         " --observed {input.observed} --out {output.samples} > {log} 2>&1"
 
 
-rule calibration_check:
+CHECK = config["calibration"]["check"]
+CHECK_BATCHES = list(range(chunk_count(CHECK["trials"], CHECK["trials_per_job"])))
+CHECK_TRUTHS = ["emulator", "hydrocode"]
+
+
+def check_truth_inputs(wildcards):
+    """Hydrocode truth: the check design's runs and their features; emulator truth: none."""
+    if wildcards.truth == "emulator":
+        return {}
+    return {
+        "design": f"{RESULTS}/check/design.parquet",
+        "features": expand(f"{RESULTS}/check/features/{{shot}}.parquet", shot=SHOTS),
+    }
+
+
+rule calibration_check_batch:
+    """One batch of synthetic-truth trials (each trial has its own random stream, so batches are
+    independent jobs and together give what one run of every trial gives)."""
     input:
+        unpack(check_truth_inputs),
         emulator=f"{RESULTS}/emulator/emulator.json",
     output:
-        f"{RESULTS}/posterior/coverage.parquet",
+        f"{RESULTS}/check/coverage/{{truth}}/batch-{{batch}}.parquet",
     log:
-        f"{LOGS}/calibrate/coverage.log",
+        f"{LOGS}/check/coverage/{{truth}}/batch-{{batch}}.log",
     benchmark:
-        f"{BENCHMARKS}/calibrate/coverage.tsv"
+        f"{BENCHMARKS}/check/coverage/{{truth}}/batch-{{batch}}.tsv"
+    wildcard_constraints:
+        truth="|".join(CHECK_TRUTHS),
+        batch=r"\d+",
     conda:
         "../envs/shockcal.yaml"
     params:
@@ -46,38 +67,36 @@ rule calibration_check:
         seed=config["study"]["seed"],
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
         shots=" ".join(SHOTS),
+        trial_range=lambda w: chunk_rows(w.batch, CHECK["trials_per_job"], CHECK["trials"]),
+        truth=lambda w, input: (
+            ""
+            if w.truth == "emulator"
+            else f"--truth-design {input.design} --truth-features "
+            + " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features))
+        ),
     shell:
-        "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
-        " --out {output} > {log} 2>&1"
+        "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots} {params.truth}"
+        " --trial-range {params.trial_range} --out {output} > {log} 2>&1"
 
 
-rule calibration_check_hydrocode:
+rule coverage:
+    """Every batch of one check merged: one row per trial and parameter; the log has the coverage table."""
     input:
-        emulator=f"{RESULTS}/emulator/emulator.json",
-        design=f"{RESULTS}/check/design.parquet",
-        features=expand(f"{RESULTS}/check/features/{{shot}}.parquet", shot=SHOTS),
+        expand(f"{RESULTS}/check/coverage/{{{{truth}}}}/batch-{{batch}}.parquet", batch=CHECK_BATCHES),
     output:
-        f"{RESULTS}/posterior/coverage_hydrocode.parquet",
+        f"{RESULTS}/posterior/coverage_{{truth}}.parquet",
     log:
-        f"{LOGS}/calibrate/coverage_hydrocode.log",
-    benchmark:
-        f"{BENCHMARKS}/calibrate/coverage_hydrocode.tsv"
+        f"{LOGS}/calibrate/coverage_{{truth}}.log",
+    wildcard_constraints:
+        truth="|".join(CHECK_TRUTHS),
     conda:
         "../envs/shockcal.yaml"
-    params:
-        calibration=config["calibration"],
-        sd_fraction=config["observed"]["sd_fraction"],
-        seed=config["study"]["seed"],
-        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
-        pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
-        shots=" ".join(SHOTS),
     shell:
-        "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots}"
-        " --truth-design {input.design} --truth-features {params.pairs} --out {output} > {log} 2>&1"
+        "shockcal coverage --trials {input} --out {output} > {log} 2>&1"
 
 
 ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)
-CHECK_TARGETS = [f"{RESULTS}/posterior/coverage.parquet", f"{RESULTS}/posterior/coverage_hydrocode.parquet"]
+CHECK_TARGETS = expand(f"{RESULTS}/posterior/coverage_{{truth}}.parquet", truth=CHECK_TRUTHS)
 
 
 rule check:
