@@ -34,21 +34,11 @@ CHECK_BATCHES = list(range(chunk_count(CHECK["trials"], CHECK["trials_per_job"])
 CHECK_TRUTHS = ["emulator", "hydrocode"]
 
 
-def check_truth_inputs(wildcards):
-    """Hydrocode truth: the check design's runs and their features; emulator truth: none."""
-    if wildcards.truth == "emulator":
-        return {}
-    return {
-        "design": f"{RESULTS}/check/design.parquet",
-        "features": expand(f"{RESULTS}/check/features/{{shot}}.parquet", shot=SHOTS),
-    }
-
-
 rule calibration_check_batch:
     """One batch of synthetic-truth trials (each trial has its own random stream, so batches are
     independent jobs and together give what one run of every trial gives)."""
     input:
-        unpack(check_truth_inputs),
+        unpack(lambda w: check_truth_inputs(w.truth, RESULTS, SHOTS)),
         emulator=f"{RESULTS}/emulator/emulator.json",
     output:
         f"{RESULTS}/check/coverage/{{truth}}/batch-{{batch}}.parquet",

@@ -6,7 +6,14 @@ import yaml
 
 from shockcal.config import shot_inputs
 from shockcal.design import chunk_fingerprints, planned_design
-from shockcal.workflow import chunk_count, chunk_rows, export_to_jobs, physics_slice, write_if_changed
+from shockcal.workflow import (
+    check_truth_inputs,
+    chunk_count,
+    chunk_rows,
+    export_to_jobs,
+    physics_slice,
+    write_if_changed,
+)
 
 # The merged config (configfile + --configfile + --config) that every shockcal call reads, named by
 # its content so a dry run with other settings never rewrites the file running jobs read. Jobs get
