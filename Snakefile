@@ -17,6 +17,11 @@ SHOTS = list(config["shots"])
 ALL_TARGETS = []
 
 
+wildcard_constraints:
+    shot="|".join(SHOTS),
+    chunk=r"\d+",
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/design.smk"
 include: "workflow/rules/simulate.smk"

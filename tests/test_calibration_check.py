@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
@@ -234,3 +235,20 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     (old / "emulator.npz").write_bytes(b"")
     assert main([*args[:4], str(old), *args[5:]]) == 2
     assert "version" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--truth-design", "d.csv"], "--truth-design and --truth-features go together"),
+    (["--truth-design", "d.csv", "--truth-features", "104S=f.csv"], r"no --truth-features for shot\(s\) \['105S'\]"),
+])
+def test_check_cli_names_what_is_missing_in_the_hydrocode_truth(extra, message, monkeypatch, capsys):
+    from pathlib import Path
+
+    from shockcal.cli import main
+
+    repo = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(repo)                       # the config's record paths are relative to the repository
+    argv = ["calibrate-check", "--config", "config/config.yaml", "--emulator", "no-such-dir", "--shots", "104S",
+            "105S", "--out", "never.parquet", *extra]
+    assert main(argv) == 2
+    assert re.search(message, capsys.readouterr().err)

@@ -115,12 +115,12 @@ def test_nothing_to_redo(study):
 def test_sampler_setting_reruns_no_simulation(study, tmp_path):
     jobs = pending_jobs(study[1], overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
     assert jobs.get("calibrate") == 4
-    assert not {"design", "simulate", "features", "emulator"} & set(jobs), jobs
+    assert not {"design", "simulate", "features_chunk", "features", "emulator"} & set(jobs), jobs
 
 
 def test_physics_setting_reruns_every_simulation(study, tmp_path):
     jobs = pending_jobs(study[1], overlay(tmp_path / "physics.yaml", hydro={"q_linear": 0.12}))
-    assert jobs["simulate"] == 12 and jobs["features"] == 3 and jobs["emulator"] == 1
+    assert jobs["simulate"] == 12 and jobs["features_chunk"] == 12 and jobs["features"] == 3 and jobs["emulator"] == 1
     assert "design" not in jobs
 
 
@@ -133,7 +133,7 @@ def test_added_design_rows_run_only_new_chunks(study, tmp_path):
     grown = tmp_path / "design.parquet"
     pd.concat([design, extra]).to_parquet(grown)
     jobs = pending_jobs(config, overlay(tmp_path / "grown.yaml", design={"file": str(grown)}))
-    assert jobs["simulate"] == 3                               # chunk 4 of each shot
+    assert jobs["simulate"] == 3 and jobs["features_chunk"] == 3     # chunk 4 of each shot
     assert jobs["features"] == 3 and jobs["emulator"] == 1
 
 
@@ -143,7 +143,7 @@ def test_added_shot_runs_only_its_simulations(study, tmp_path):
     record = dict(quick["observed"]["records"]["106S"])          # a fourth shot comes with its record
     more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"records": {"107S": record}})
     jobs = pending_jobs(study[1], more)
-    assert jobs["simulate"] == 4                               # the 4 chunks of 107S only
+    assert jobs["simulate"] == 4 and jobs["features_chunk"] == 4     # the 4 chunks of 107S only
     assert jobs["features"] == 1
 
 
@@ -176,8 +176,8 @@ def test_coverage_checks_fan_out_in_batches_of_trials(study):
 
 
 def test_deleted_intermediates_rerun_only_their_dependents(study):
-    """A deleted simulation chunk reruns that chunk and what depends on it; a deleted features table
-    reruns its shot's features and what follows, and no simulation."""
+    """A deleted simulation chunk reruns that chunk, its features and what depends on them; a deleted
+    features table reruns its shot's merge and what follows, and no simulation or extraction."""
     results, config = study
     chunk = results / "simulations" / "104S" / "chunk-1.parquet"
     features = results / "features" / "105S.parquet"
@@ -189,7 +189,8 @@ def test_deleted_intermediates_rerun_only_their_dependents(study):
     finally:
         for path, aside in kept.items():
             aside.rename(path)
-    assert jobs["simulate"] == 1 and jobs["features"] == 2 and jobs["emulator"] == 1, jobs
+    assert jobs["simulate"] == 1 and jobs["features_chunk"] == 1 and jobs["features"] == 2, jobs
+    assert jobs["emulator"] == 1, jobs
     assert pending_jobs(config) == {}
 
 
@@ -207,7 +208,7 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
     more = overlay(tmp_path / "shot.yaml", design={"file": str(grown)}, inputs={"V4": box},
                    shots={"107S": shot}, observed={"records": {"107S": dict(quick["observed"]["records"]["106S"])}})
     jobs = pending_jobs(config, more)
-    assert jobs["simulate"] == 4 and jobs["features"] == 1, jobs   # the 4 chunks of 107S, its features
+    assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
 
 
 def test_bad_config_is_rejected_before_any_job(tmp_path):

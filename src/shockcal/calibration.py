@@ -271,6 +271,17 @@ class HydroTruths:
     design: pd.DataFrame
     features: dict            # shot -> features table (run, status, feature columns)
 
+    @classmethod
+    def read(cls, design_path, feature_paths: dict, shots) -> HydroTruths:
+        """From a design table and each shot's features table (CSV or Parquet); every shot calibrated
+        needs its features."""
+        from shockcal.io import read_table
+
+        missing = sorted(set(shots) - set(feature_paths))
+        if missing:
+            raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
+        return cls(read_table(design_path), {shot: read_table(path) for shot, path in feature_paths.items()})
+
     def table(self, names, shots) -> list:
         """(theta, features) of each usable run (every shot's features ok and positive), in run order."""
         table = self.design.set_index("run")

@@ -128,11 +128,21 @@ def validate_shot_parameters(design: pd.DataFrame, config: dict, shot: str, sour
             raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {shot}")
 
 
+def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
+                 lhs: bool = False) -> tuple[pd.DataFrame, str]:
+    """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
+    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box, seeded from
+    `stream` of study.seed (`shockcal.seeds`) unless `seed` is given."""
+    if config["design"]["file"] and not lhs:
+        design = load_design(config["design"]["file"], config)
+        return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
+    seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
+    return latin_hypercube(config, n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
+
+
 def planned_design(config: dict) -> pd.DataFrame:
-    """The study's design as `shockcal design` writes it: the config's design file, or its LHS."""
-    if config["design"]["file"]:
-        return load_design(config["design"]["file"], config)
-    return latin_hypercube(config, config["design"]["n_runs"], stream_seed(config["study"]["seed"], "design"))
+    """The study's design as `shockcal design` writes it (the Snakefile plans its chunks from it)."""
+    return study_design(config)[0]
 
 
 def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:

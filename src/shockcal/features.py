@@ -225,6 +225,20 @@ def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
 
 
+def merge_feature_tables(tables, sources) -> pd.DataFrame:
+    """Features tables of chunks of one shot's runs as one table sorted by run; a run in two chunks
+    is an InputError naming both sources."""
+    import pandas as pd
+
+    table = pd.concat(tables, ignore_index=True)
+    repeated = table["run"].duplicated(keep=False)
+    if repeated.any():
+        run = int(table.loc[repeated, "run"].iloc[0])
+        holders = [str(src) for src, part in zip(sources, tables) if (part["run"] == run).any()]
+        raise InputError(f"run {run} is in more than one features table: {', '.join(holders)}")
+    return table.sort_values("run").reset_index(drop=True)
+
+
 def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:
     """The ten features of a measured record, with the shot's analysis settings; InputError naming the
     record when it has none."""

@@ -288,6 +288,7 @@ def benchmark_file(results: Path, comment: str) -> Path | None:
     bench = results / "benchmarks"
     candidates = {
         "simulate": lambda: bench / "simulate" / wildcards[0] / f"chunk-{wildcards[1]}.tsv",
+        "features_chunk": lambda: bench / "features" / wildcards[0] / f"chunk-{wildcards[1]}.tsv",
         "features": lambda: bench / "features" / f"{wildcards[0]}.tsv",
         "calibrate": lambda: bench / "calibrate" / f"{wildcards[0]}.tsv",
         "emulator": lambda: bench / "emulator.tsv",
@@ -390,6 +391,8 @@ def main() -> int:
     for rule in ("design", "observed", "check_design"):
         if planned.get(rule):
             failures.append(f"run 2 reran {rule}, which run 1 had finished")
+    if planned.get("features_chunk", 0) > 1:
+        failures.append(f"run 2 extracted {planned['features_chunk']} chunks' features, expected 1 (the cancelled chunk)")
     if planned.get("features", 0) > 1:
         failures.append(f"run 2 reran features of {planned['features']} shots, expected only {shot}")
     after = mtimes(results)

@@ -1,9 +1,28 @@
-# Features: per shot from all its simulation chunks; observed features from the config or records.
+# Features: per simulation chunk (they fan out with the simulations), merged per shot, where the
+# failed-run budget is checked; observed features from the config or records.
+
+
+rule features_chunk:
+    input:
+        f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
+    output:
+        f"{RESULTS}/features/{{shot}}/chunk-{{chunk}}.parquet",
+    log:
+        f"{LOGS}/features/{{shot}}/chunk-{{chunk}}.log",
+    benchmark:
+        f"{BENCHMARKS}/features/{{shot}}/chunk-{{chunk}}.tsv"
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        features=config["features"],
+        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
+    shell:
+        "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget --out {output} > {log} 2>&1"
 
 
 rule features:
     input:
-        expand(f"{RESULTS}/simulations/{{{{shot}}}}/chunk-{{chunk}}.parquet", chunk=CHUNKS),
+        expand(f"{RESULTS}/features/{{{{shot}}}}/chunk-{{chunk}}.parquet", chunk=CHUNKS),
     output:
         f"{RESULTS}/features/{{shot}}.parquet",
     log:
@@ -13,11 +32,9 @@ rule features:
     conda:
         "../envs/shockcal.yaml"
     params:
-        features=config["features"],
-        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
         max_failed_fraction=config["simulate"]["max_failed_fraction"],
     shell:
-        "shockcal features --shot {wildcards.shot} --traces {input} --out {output} > {log} 2>&1"
+        "shockcal features --shot {wildcards.shot} --tables {input} --out {output} > {log} 2>&1"
 
 
 rule observed:

@@ -122,14 +122,9 @@ def hydro_truths(args):
     """The hydrocode truth runs named on the command line, or None (emulator truth)."""
     from shockcal.calibration import HydroTruths
     from shockcal.errors import InputError
-    from shockcal.io import read_table
 
     if not args.truth_design and not args.truth_features:
         return None
     if not (args.truth_design and args.truth_features):
         raise InputError("calibrate-check: --truth-design and --truth-features go together")
-    features = {shot: read_table(path) for shot, path in parse_pairs(args.truth_features, "--truth-features").items()}
-    missing = sorted(set(args.shots) - set(features))
-    if missing:
-        raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
-    return HydroTruths(read_table(args.truth_design), features)
+    return HydroTruths.read(args.truth_design, parse_pairs(args.truth_features, "--truth-features"), args.shots)

@@ -22,24 +22,13 @@ def run(args) -> int:
     import logging
 
     from shockcal.config import input_names, load_config
-    from shockcal.design import latin_hypercube, load_design
+    from shockcal.design import study_design
     from shockcal.io import write_table
-    from shockcal.seeds import stream_seed
 
     config = load_config(args.config)
-    log = logging.getLogger("shockcal.design")
-    if config["design"]["file"] and not args.lhs:
-        design = load_design(config["design"]["file"], config)
-        source = f"file {config['design']['file']}"
-        if args.n_runs is not None:
-            design = design.iloc[: args.n_runs]
-    else:
-        n_runs = args.n_runs or config["design"]["n_runs"]
-        seed = stream_seed(config["study"]["seed"], args.stream) if args.seed is None else args.seed
-        design = latin_hypercube(config, n_runs, seed)
-        source = f"Latin hypercube, seed {seed}"
+    design, source = study_design(config, args.n_runs, args.seed, args.stream, args.lhs)
     units = {name: config["inputs"][name]["unit"] for name in input_names(config)}
     write_table(design[["run", *input_names(config)]], args.out,
                 {"table": "design", "source": source, "units": units})
-    log.info("wrote %d runs (%s) to %s", len(design), source, args.out)
+    logging.getLogger("shockcal.design").info("wrote %d runs (%s) to %s", len(design), source, args.out)
     return 0

@@ -17,6 +17,10 @@ def register(subparsers) -> None:
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--traces", nargs="+", help="simulation tables (Parquet or CSV) from `shockcal simulate`")
     source.add_argument("--record", help="a measured record (time us, velocity m/s)")
+    source.add_argument("--tables", nargs="+",
+                        help="features tables of chunks of one shot's runs (--traces ... --no-failure-budget): merged")
+    p.add_argument("--no-failure-budget", action="store_true",
+                   help="--traces of one chunk: leave the failed-run budget (simulate.max_failed_fraction) to the merge")
     p.add_argument("--time-column", help="record: time column name or index (default: detected)")
     p.add_argument("--velocity-column", help="record: velocity column name or index (default: detected)")
     p.add_argument("--out", required=True, help="output Parquet table")
@@ -42,11 +46,15 @@ def run(args) -> int:
                                **record_features(config, args.shot, args.record, args.time_column,
                                                  args.velocity_column)}])
     else:
-        from shockcal.features import features_table
+        from shockcal.features import features_table, merge_feature_tables
 
-        traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
-        table = features_table(traces, config, args.shot)
-        check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
+        if args.tables:
+            table = merge_feature_tables([read_table(path) for path in args.tables], args.tables)
+        else:
+            traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
+            table = features_table(traces, config, args.shot)
+        if not args.no_failure_budget:
+            check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
     write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,
                                   "analysis": config["shots"][args.shot]["analysis"]})
     return 0
