@@ -26,7 +26,8 @@
    A trace with a single wave (elastic only at large A, or a precursor merged with the plastic
    rise) puts every component on one side: then the latest (resp. earliest) component is taken as
    the late (early) mixture, so every run of the design box has features, as FLAG's had; the slope
-   times are kept at or after the elastic time (FLAG's single-wave runs have all points on the top).
+   times are kept at or after the elastic time (FLAG's single-wave runs have all points on the top),
+   and a stand-in early component's jump-off and elastic times inside [window start, cut-off].
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time.
