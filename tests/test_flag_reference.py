@@ -2,7 +2,7 @@
 
 `make validate` compares all 500 runs of every shot (docs/hydro.md); these tests keep two of its
 findings from regressing at a test's cost: the single-wave traces of 104S, where the early/late
-split decides what "elastic plateau" means, and the goals met on a fixed sample of the design.
+split decides what "elastic plateau" means, and the plateau goals on a fixed sample of the design.
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ from shockcal.simulate import simulate_design
 SINGLE_WAVE_RUNS_104S = [202, 248, 212, 354, 418, 421, 292, 466, 289, 52]
 SAMPLE_STRIDE = 25      # runs 0, 25, ..., 475 of each shot for the slow check
 RMSE_GOALS_M_S = {"v_elastic": 1.5, "v_plastic": 2.5}   # issue 12's goals met in every shot
-RISE_BIAS_GOAL_NS = 15.0
 
 
 def errors_against_flag(reference_data, config, shot, runs) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -49,7 +48,7 @@ def test_single_wave_traces_read_the_elastic_plateau_like_flag(reference_data, p
 @pytest.mark.parametrize("shot", ["104S", "105S", "106S"])
 def test_goals_met_on_a_fixed_sample_of_the_design(reference_data, paper_config, shot):
     ours, flag = errors_against_flag(reference_data, paper_config, shot, list(range(0, 500, SAMPLE_STRIDE)))
+    # The rise-time bias goal (15 ns) is judged by `make validate` on all 500 runs only: per run the
+    # rise time scatters by 72 ns RMSE in 104S, so the mean of 20 runs has a standard error of ~16 ns.
     for feature, goal in RMSE_GOALS_M_S.items():
         assert rmse(ours[feature], flag[feature]) <= goal, feature
-    rise_bias_ns = 1e3 * np.mean((ours["t_slope2"] - ours["t_slope1"]) - (flag["t_slope2"] - flag["t_slope1"]))
-    assert abs(rise_bias_ns) <= RISE_BIAS_GOAL_NS
