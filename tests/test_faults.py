@@ -17,8 +17,7 @@ import pytest
 import yaml
 
 from shockcal.calibration import calibrate
-from shockcal.cli import main, parse_pairs
-from shockcal.cli.simulate import parse_rows
+from shockcal.cli import main, parse_pairs, parse_span
 from shockcal.config import load_config, validate_config
 from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
 from shockcal.errors import ConfigError, InputError, ShockcalError
@@ -295,7 +294,7 @@ def test_command_line_faults():
     with pytest.raises(InputError, match="--features: '104S' is not SHOT=FILE"):
         parse_pairs(["104S"], "--features")
     with pytest.raises(InputError, match="--rows: '3-5' is not START:STOP"):
-        parse_rows("3-5")
+        parse_span("3-5", "--rows")
     failed = pd.DataFrame({"run": [0, 1, 2], "status": ["ok", "failed", "failed"], "reason": ["", "NaN", "NaN"]})
     with pytest.raises(ShockcalError, match=r"shot 104S: 2 of 3 runs failed.*\n  run 1: NaN"):
         check_failures(failed, 0.05, "104S")

@@ -223,7 +223,7 @@ def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=Non
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
                          f"but only {len(hydro_draws)} truth runs are usable")
     rows = []
-    for trial in trial_ids:
+    for done, trial in enumerate(trial_ids, 1):
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
         if hydro_draws is None:
             theta, eta = _emulator_truth(emulator, shots, names, rng)
@@ -238,7 +238,7 @@ def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=Non
             q05, q95 = summary.loc[name, ["q05", "q95"]]
             rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
                          "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"]})
-        log.info("synthetic trial %d done (%d of %d)", trial, len(rows) // (len(names) + 1), len(trial_ids))
+        log.info("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))
     return pd.DataFrame(rows)
 
 

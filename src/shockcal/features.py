@@ -143,10 +143,15 @@ def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float
     return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
 
 
+def ends_before(mixture: Mixture, cutoff_us: float) -> np.ndarray:
+    """Mask of the components that end (mu + 2 sigma) before the cut-off."""
+    return mixture.means + 2 * mixture.sds < cutoff_us
+
+
 def split_early(mixture: Mixture, cutoff_us: float) -> np.ndarray:
-    """Mask of the early (elastic) components: mu + 2 sigma before the cut-off. A single wave puts
+    """Mask of the early (elastic) components: those ending before the cut-off. A single wave puts
     every component on one side; then the latest (resp. earliest) one is moved to the other side."""
-    early = mixture.means + 2 * mixture.sds < cutoff_us
+    early = ends_before(mixture, cutoff_us)
     if early.all():          # one wave only (elastic, large A): its latest component is the late mixture
         early[np.argmax(mixture.means)] = False
     elif not early.any():    # the precursor merges with the plastic rise: its earliest component is early
@@ -164,7 +169,7 @@ def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarr
     on the plastic plateau: v_elastic = v_plastic)."""
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
     jumpoff, elastic = early_mix.quantile(0.01), early_mix.quantile(0.99)
-    if not np.any(early_mix.means + 2 * early_mix.sds < cutoff_us):
+    if not ends_before(early_mix, cutoff_us).any():
         jumpoff, elastic = max(jumpoff, t_window[0]), min(elastic, cutoff_us)
     slope1 = max(late_mix.quantile(0.1), elastic)     # a single wave's broad last component can reach back
     times = {"jumpoff": jumpoff, "elastic": elastic,
@@ -224,20 +229,6 @@ def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
-
-
-def merge_feature_tables(tables, sources) -> pd.DataFrame:
-    """Features tables of chunks of one shot's runs as one table sorted by run; a run in two chunks
-    is an InputError naming both sources."""
-    import pandas as pd
-
-    table = pd.concat(tables, ignore_index=True)
-    repeated = table["run"].duplicated(keep=False)
-    if repeated.any():
-        run = int(table.loc[repeated, "run"].iloc[0])
-        holders = [str(src) for src, part in zip(sources, tables) if (part["run"] == run).any()]
-        raise InputError(f"run {run} is in more than one features table: {', '.join(holders)}")
-    return table.sort_values("run").reset_index(drop=True)
 
 
 def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:

@@ -40,6 +40,19 @@ def read_table(path: str | Path) -> pd.DataFrame:
     raise InputError(f"table {path}: unknown format '{suffix}' (expected .parquet, .pq or .csv)")
 
 
+def read_tables(paths, keys: list[str], what: str) -> pd.DataFrame:
+    """Tables holding parts of one table (a shot's chunks, a check's batches) as one, stably sorted by
+    the first key column; rows repeating `keys` across the parts are an InputError naming the files."""
+    parts = [read_table(path) for path in paths]
+    table = pd.concat(parts, ignore_index=True)
+    repeated = table.duplicated(keys, keep=False)
+    if repeated.any():
+        value = table.loc[repeated, keys[0]].iloc[0]
+        holders = [str(path) for path, part in zip(paths, parts) if (part[keys[0]] == value).any()]
+        raise InputError(f"{keys[0]} {value} is in more than one {what} table: {', '.join(holders)}")
+    return table.sort_values(keys[0], kind="stable").reset_index(drop=True)
+
+
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict | None = None) -> Path:
     """Write `df` as Parquet atomically, with `metadata` (JSON-serialisable) in the schema."""
     import pyarrow as pa

@@ -47,6 +47,18 @@ def parse_pairs(pairs: list[str], option: str) -> dict[str, str]:
     return parsed
 
 
+def parse_span(text: str, option: str) -> tuple[int | None, int | None]:
+    """'START:STOP' -> (start, stop), either side may be empty (None); anything else is an InputError."""
+    parts = text.split(":")
+    if len(parts) != 2:
+        raise InputError(f"{option}: '{text}' is not START:STOP")
+    try:
+        start, stop = (int(p) if p else None for p in parts)
+    except ValueError:
+        raise InputError(f"{option}: '{text}' is not START:STOP with integers") from None
+    return start, stop
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shockcal", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"shockcal {__version__}")

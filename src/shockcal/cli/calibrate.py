@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_config_argument, parse_pairs, parse_span
 
 
 def register(subparsers) -> None:
@@ -22,7 +22,7 @@ def register(subparsers) -> None:
     c.add_argument("--out", required=True, help="coverage table (Parquet), one row per trial and parameter")
     trials = c.add_mutually_exclusive_group()
     trials.add_argument("--trials", type=int, help="override calibration.check.trials")
-    trials.add_argument("--trial-range", type=parse_trial_range, metavar="START:STOP",
+    trials.add_argument("--trial-range", metavar="START:STOP",
                         help="run trials START..STOP-1 only (a batch of the check; `shockcal coverage` merges them)")
     c.add_argument("--truth-design", help="hydrocode truth: design table of the truth runs (CSV or Parquet)")
     c.add_argument("--truth-features", nargs="+", metavar="SHOT=TABLE",
@@ -33,15 +33,6 @@ def register(subparsers) -> None:
     m.add_argument("--trials", required=True, nargs="+", help="per-trial tables (calibrate-check --out)")
     m.add_argument("--out", required=True, help="merged per-trial table (Parquet)")
     m.set_defaults(func=run_coverage)
-
-
-def parse_trial_range(text: str) -> range:
-    import argparse
-
-    start, _, stop = text.partition(":")
-    if not (start.isdigit() and stop.isdigit() and int(start) < int(stop)):
-        raise argparse.ArgumentTypeError(f"{text!r} is not START:STOP with 0 <= START < STOP")
-    return range(int(start), int(stop))
 
 
 def summary_path(out):
@@ -86,7 +77,7 @@ def run_check(args) -> int:
     config = load_config(args.config)
     truths = hydro_truths(args)
     table, coverage = coverage_check(Emulator.load(args.emulator), args.shots, config,
-                                     trials=args.trial_range or args.trials, truths=truths)
+                                     trials=trial_range(args.trial_range) or args.trials, truths=truths)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
     log_coverage(coverage)
@@ -94,18 +85,10 @@ def run_check(args) -> int:
 
 
 def run_coverage(args) -> int:
-    import pandas as pd
-
     from shockcal.calibration import coverage_table
-    from shockcal.errors import InputError
-    from shockcal.io import read_table, write_table
+    from shockcal.io import read_tables, write_table
 
-    table = pd.concat([read_table(path) for path in args.trials], ignore_index=True)
-    repeated = table.duplicated(["trial", "parameter"])
-    if repeated.any():
-        raise InputError(f"coverage: trial {int(table.loc[repeated, 'trial'].iloc[0])} is in more than one of "
-                         f"{args.trials}")
-    table = table.sort_values(["trial"], kind="stable").reset_index(drop=True)
+    table = read_tables(args.trials, ["trial", "parameter"], "per-trial")
     write_table(table, args.out, {"table": "synthetic-truth coverage", "batches": args.trials})
     log_coverage(coverage_table(table))
     return 0
@@ -116,6 +99,18 @@ def log_coverage(coverage) -> None:
 
     logging.getLogger("shockcal.calibrate").info("coverage of nominal 90%% intervals:\n%s",
                                                   coverage.to_string(index=False, float_format="%.3f"))
+
+
+def trial_range(text: str | None) -> range | None:
+    """--trial-range START:STOP as the trial numbers START..STOP-1 (both given, START < STOP)."""
+    from shockcal.errors import InputError
+
+    if text is None:
+        return None
+    start, stop = parse_span(text, "--trial-range")
+    if start is None or stop is None or not 0 <= start < stop:
+        raise InputError(f"--trial-range: '{text}' is not START:STOP with 0 <= START < STOP")
+    return range(start, stop)
 
 
 def hydro_truths(args):

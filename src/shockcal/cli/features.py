@@ -46,10 +46,11 @@ def run(args) -> int:
                                **record_features(config, args.shot, args.record, args.time_column,
                                                  args.velocity_column)}])
     else:
-        from shockcal.features import features_table, merge_feature_tables
+        from shockcal.features import features_table
+        from shockcal.io import read_tables
 
         if args.tables:
-            table = merge_feature_tables([read_table(path) for path in args.tables], args.tables)
+            table = read_tables(args.tables, ["run"], "features")
         else:
             traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
             table = features_table(traces, config, args.shot)

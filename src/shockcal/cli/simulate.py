@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_config_argument, parse_span
 
 
 def register(subparsers) -> None:
@@ -17,19 +17,6 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def parse_rows(text: str) -> slice:
-    from shockcal.errors import InputError
-
-    parts = text.split(":")
-    if len(parts) != 2:
-        raise InputError(f"--rows: '{text}' is not START:STOP")
-    try:
-        start, stop = (int(p) if p else None for p in parts)
-    except ValueError:
-        raise InputError(f"--rows: '{text}' is not START:STOP with integers") from None
-    return slice(start, stop)
-
-
 def run(args) -> int:
     import logging
 
@@ -41,7 +28,7 @@ def run(args) -> int:
 
     config = load_config(args.config)
     shot_config(config, args.shot)
-    rows = parse_rows(args.rows)
+    rows = slice(*parse_span(args.rows, "--rows"))
     design = load_design(args.design, config, columns=shot_inputs(config, args.shot)).iloc[rows]
     validate_shot_parameters(design, config, args.shot, args.design)
     if args.end_time_us is not None and args.end_time_us <= 0:
