@@ -60,6 +60,7 @@ def main() -> None:
     flag = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
     print("FLAG features, runs 0-499 (joint):")
     emulator = timed("fit", lambda: fit_emulator(config, design, flag))
+    print(f"  ({len(emulator.blocks[0].model.gps)} components)")
     cv = [timed("closed-form LOO", lambda: emulator.cv_table("loo_closed_form"))]
     cv.append(timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"])))
     cv.append(timed("outer check", lambda: emulator.cv_table("outer", margin=settings["outer_margin"])))
@@ -75,6 +76,7 @@ def main() -> None:
     print("1000 runs x 12 features (synthetic response):")
     start = time.perf_counter()
     emulator = timed("fit", lambda: fit_emulator(config, design, synthetic_features(design, config)))
+    print(f"  ({len(emulator.blocks[0].model.gps)} components)")
     timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"]))
     print(f"  fit + K-fold: {time.perf_counter() - start:.1f} s ({load()})")
     with threadpool_limits(1, user_api="blas"):

@@ -42,6 +42,20 @@ def test_kernel_slope_is_the_derivative(family):
 
 
 @pytest.mark.parametrize("family", KERNELS)
+def test_correlation_matrix_matches_the_formula(family):
+    from scipy.spatial.distance import cdist
+
+    from shockcal.gp import correlation
+
+    rng = np.random.default_rng(7)
+    a, b, beta = rng.uniform(size=(7, 3)), rng.uniform(size=(5, 3)), np.array([0.5, 4.0, 20.0])
+    r = cdist(a * np.sqrt(beta), b * np.sqrt(beta))
+    expected = {"gaussian": np.exp(-r**2), "matern52": (1 + np.sqrt(5) * r + 5 * r**2 / 3) * np.exp(-np.sqrt(5) * r),
+                "matern32": (1 + np.sqrt(3) * r) * np.exp(-np.sqrt(3) * r)}[family]
+    np.testing.assert_allclose(correlation(a, b, beta, family), expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("family", KERNELS)
 def test_gradient_of_the_hyperparameter_posterior(family):
     from scipy.optimize import check_grad
 
@@ -124,8 +138,10 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(paper_config, design, {"104S": features, "105S": features})
     input_map = emulator.blocks[0].input_map
-    strain = paper_config["emulator"]["hardening_strain"]
-    np.testing.assert_allclose(input_map.raw(design)[:, -1], strain ** design["n"])
+    strain, temperature = (paper_config["emulator"][k] for k in ("hardening_strain", "homologous_temperature"))
+    np.testing.assert_allclose(input_map.raw(design)[:, -2:], np.column_stack([strain ** design["n"],
+                                                                               temperature ** design["m"]]))
+    assert np.all((input_map.scaled(design) >= 0) & (input_map.scaled(design) <= 1))
     emulator.save(tmp_path / "emu")
     new = latin_hypercube(paper_config, 7, 2).assign(run=lambda d: d["run"] + 100)
     new.to_csv(tmp_path / "new.csv", index=False)

@@ -22,13 +22,15 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import asdict, dataclass
+from concurrent.futures import ThreadPoolExecutor
+from functools import cache
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController, threadpool_limits
 
 from shockcal.config import STRENGTH_INPUTS, shot_config
 from shockcal.errors import InputError
@@ -36,23 +38,26 @@ from shockcal.gp import GaussianProcess, Hyper
 from shockcal.io import atomic_path
 from shockcal.seeds import stream_seed
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3                  # 3: input powers for n and m (2 had the strain^n input only)
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
+# extra emulator inputs base^column: config emulator key of the base, design column
+POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
 log = logging.getLogger("shockcal.emulator")
 
 
 @dataclass
 class InputMap:
-    """How one emulator's inputs derive from design inputs: each is a sum of design columns, plus,
-    when `strain` > 0, a last input strain^n (the Johnson-Cook hardening factor at that plastic
-    strain: steep in n near 0, where the elastic precursor changes fastest)."""
+    """How one emulator's inputs derive from design inputs: each is a sum of design columns, then
+    one input base^column for each entry of `powers`: the Johnson-Cook factors eps^n at a plastic
+    strain eps and T*^m at a homologous temperature T*. Both are steep near n = 0 and m = 0, where
+    the features change fastest, and smooth and monotone everywhere."""
 
     names: list[str]            # emulator input names, e.g. [A, B, C, n, m, V2, G_105S]
     terms: list[list[str]]      # design columns summed into each input
-    lower: np.ndarray           # box of each input (sum of the terms' bounds), strain^n last
+    lower: np.ndarray           # box of each input (sum of the terms' bounds), the powers last
     upper: np.ndarray
-    strain: float = 0.0
+    powers: list[tuple[float, str]] = field(default_factory=list)   # (base, design column)
 
     def design_inputs(self) -> list[str]:
         return list(dict.fromkeys(t for terms in self.terms for t in terms))
@@ -60,8 +65,7 @@ class InputMap:
     def raw(self, inputs) -> np.ndarray:
         """(N, d) inputs (sums of design columns, strain^n) from a mapping or DataFrame of design columns."""
         raw = [sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms]
-        if self.strain:
-            raw.append(self.strain ** np.asarray(inputs["n"], dtype=float))
+        raw += [base ** np.asarray(inputs[column], dtype=float) for base, column in self.powers]
         return np.column_stack(raw)
 
     def scaled(self, inputs) -> np.ndarray:
@@ -70,11 +74,12 @@ class InputMap:
 
     def to_json(self) -> dict:
         return {"names": self.names, "terms": self.terms, "lower": self.lower.tolist(), "upper": self.upper.tolist(),
-                "strain": self.strain}
+                "powers": [list(p) for p in self.powers]}
 
     @classmethod
     def from_json(cls, d: dict) -> InputMap:
-        return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]), d["strain"])
+        return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]),
+                   [(float(b), str(c)) for b, c in d["powers"]])
 
 
 def shot_input_map(config: dict, shot: str) -> InputMap:
@@ -99,11 +104,11 @@ def _shot_terms(config, shot):
 def _box_map(config, names, terms) -> InputMap:
     lower = [sum(config["inputs"][t]["min"] for t in ts) for ts in terms]
     upper = [sum(config["inputs"][t]["max"] for t in ts) for ts in terms]
-    strain = config["emulator"]["hardening_strain"]
-    if strain:
-        lower.append(strain ** config["inputs"]["n"]["max"])
-        upper.append(strain ** config["inputs"]["n"]["min"])
-    return InputMap(names, terms, np.array(lower), np.array(upper), strain)
+    powers = [(config["emulator"][key], column) for key, column in POWER_INPUTS if config["emulator"][key]]
+    for base, column in powers:             # base < 1: base^column falls as the column grows
+        lower.append(base ** config["inputs"][column]["max"])
+        upper.append(base ** config["inputs"][column]["min"])
+    return InputMap(names, terms, np.array(lower), np.array(upper), powers)
 
 
 @dataclass
@@ -116,7 +121,7 @@ class Settings:
     n_starts: int = 2              # L-BFGS-B starts per GP
     max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
     seed: int = 0
-    n_jobs: int = 1                # processes for the GP fits (one BLAS thread each)
+    n_jobs: int = 1                # processes for the GP fits, threads for prediction (one BLAS thread each)
     cv_folds: int = 10             # K-fold of the sd calibration
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
 
@@ -141,6 +146,12 @@ def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSeq
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
                                    family=settings.family, fit_mean=settings.fit_mean).hyper
+
+
+@cache
+def _blas_threads() -> ThreadpoolController:
+    """The process's thread pools, inspected once (a fresh inspection costs ~2.5 ms per prediction)."""
+    return ThreadpoolController()
 
 
 class PCGPEmulator:
@@ -227,13 +238,22 @@ class PCGPEmulator:
 
     def predict_scaled(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Mean (N, F) and covariance (N, F, F) at inputs x scaled to [0, 1]."""
-        w_mean = np.empty((len(x), len(self.gps)))
-        w_var = np.empty_like(w_mean)
-        for j, gp in enumerate(self.gps):
-            w_mean[:, j], w_var[:, j] = gp.predict(x)
+        w_mean, w_var = self._predict_weights(np.ascontiguousarray(x, dtype=float))
         z_cov = np.einsum("nj,jf,jg->nfg", w_var, self.basis, self.basis) + self.residual_cov
         mean = self.mean + (w_mean @ self.basis) * self.scale
         return mean, z_cov * np.outer(self.scale * self.sd_factor, self.scale * self.sd_factor)
+
+    def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Mean and variance (N, p) of each basis weight at scaled inputs x: the component GPs on
+        `settings.n_jobs` threads with one BLAS thread each (numba's correlation kernels release the
+        GIL; more BLAS threads per solve measured slower, docs/emulator.md "Speed")."""
+        with _blas_threads().limit(limits=1, user_api="blas"):
+            if self.settings.n_jobs > 1 and len(self.gps) > 1:
+                with ThreadPoolExecutor(self.settings.n_jobs) as pool:
+                    parts = list(pool.map(lambda gp: gp.predict(x), self.gps))
+            else:
+                parts = [gp.predict(x) for gp in self.gps]
+        return np.column_stack([m for m, _ in parts]), np.column_stack([v for _, v in parts])
 
     def loo(self) -> HeldOut:
         """Closed-form leave-one-out (hyperparameters and basis fixed): a fast diagnostic that flatters."""

@@ -18,41 +18,27 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg, optimize
 
+from shockcal.correlation import (FAMILIES, correlation_and_slope, cross_correlation, family_code,
+                                  gradient_sums, values_and_slopes)
+
 LAMBDA_W_PRIOR = (5.0, 5.0)         # Gamma(shape, rate) of the marginal precision
 RHO_PRIOR = (1.0, 0.1)              # Beta(a, b) of each rho_k
 LAMBDA_N_PRIOR = (3.0, 0.003)       # Gamma(shape, rate) of the nugget precision
 LOG_BOUNDS = {"lambda_w": (-6.0, 8.0), "beta": (np.log(1e-4), np.log(2e3)), "lambda_n": (0.0, 25.0)}
-KERNELS = ("gaussian", "matern52", "matern32")
-SQRT3, SQRT5 = np.sqrt(3.0), np.sqrt(5.0)
+KERNELS = FAMILIES
 
 
 def kernel(r2: np.ndarray, family: str, slope: bool = True):
     """Correlation c(r^2) and, with `slope`, its derivative dc/d(r^2), for a correlation family."""
-    if family == "gaussian":
-        c = np.exp(-r2)
-        return (c, -c) if slope else c
-    if family not in KERNELS:
-        raise ValueError(f"unknown correlation family {family!r}; expected one of {KERNELS}")
-    root = SQRT5 if family == "matern52" else SQRT3
-    s = np.sqrt(r2)
-    s *= root                                   # s = root * r
-    e = np.exp(-s)
-    if family == "matern52":                    # (1 + s + s^2/3) e,  dc/dr^2 = -(5/6)(1 + s) e
-        c = (1.0 + s + s * s / 3.0) * e
-        return (c, -(5.0 / 6.0) * (1.0 + s) * e) if slope else c
-    c = (1.0 + s) * e                           # Matern 3/2: (1 + s) e,  dc/dr^2 = -(3/2) e
-    return (c, -1.5 * e) if slope else c
-
-
-def scaled_distances(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """r^2 = sum_k beta_k (a_k - b_k)^2 via a matrix product (no (n, m, d) temporary)."""
-    sa, sb = a * np.sqrt(beta), b * np.sqrt(beta)
-    return np.maximum((sa**2).sum(1)[:, None] + (sb**2).sum(1)[None, :] - 2.0 * sa @ sb.T, 0.0)
+    r2 = np.asarray(r2, dtype=float)
+    c, dc = values_and_slopes(r2.ravel(), family_code(family))
+    return (c.reshape(r2.shape), dc.reshape(r2.shape)) if slope else c.reshape(r2.shape)
 
 
 def correlation(a: np.ndarray, b: np.ndarray, beta: np.ndarray, family: str = "gaussian") -> np.ndarray:
     """Correlation matrix between the rows of a and b."""
-    return kernel(scaled_distances(a, b, beta), family, slope=False)
+    return cross_correlation(np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float),
+                             np.asarray(beta, dtype=float), family_code(family))
 
 
 @dataclass
@@ -106,14 +92,13 @@ def neg_log_posterior(phi: np.ndarray, x: np.ndarray, y: np.ndarray, family: str
                       fit_mean: bool) -> tuple[float, np.ndarray]:
     """Negative log marginal posterior of the hyperparameters and its analytic gradient.
 
-    Distances and the length-scale gradient go through matrix products (no (n, n, d) table). With
-    `fit_mean` the constant mean is profiled out at its GLS estimate (no extra gradient term there).
+    The correlation matrix, its slope and the gradient's sums over pairs are numba kernels
+    (`shockcal.correlation`). With `fit_mean` the constant mean is profiled out at its GLS estimate
+    (no extra gradient term there).
     """
     hyp = Hyper.unpack(phi)
     n = len(y)
-    r2 = scaled_distances(x, x, hyp.beta)
-    r2.flat[::n + 1] = 0.0
-    corr, slope = kernel(r2, family)
+    corr, slope = correlation_and_slope(x, hyp.beta, family_code(family))
     cov = corr / hyp.lambda_w
     cov.flat[::n + 1] += 1.0 / hyp.lambda_n + jitter
     try:
@@ -122,17 +107,17 @@ def neg_log_posterior(phi: np.ndarray, x: np.ndarray, y: np.ndarray, family: str
         return np.inf, np.zeros_like(phi)
     resid = y - _gls_mean(factor, y) if fit_mean else y
     alpha = linalg.cho_solve(factor, resid, check_finite=False)
-    inv = _inverse_from_cholesky(factor[0])
+    inv_lower, info = linalg.lapack.dpotri(factor[0], lower=1)
+    if info != 0:
+        return np.inf, np.zeros_like(phi)
     logdet = 2.0 * np.log(np.diag(factor[0])).sum()
     nll = 0.5 * resid @ alpha + 0.5 * logdet
-    w = inv - np.outer(alpha, alpha)            # d nll / d cov = w / 2
+    # d nll / d cov = W / 2 with W = K^-1 - alpha alpha'
+    w_corr, pair_sums, w_trace = gradient_sums(inv_lower, alpha, corr, slope, x)
     grad = np.empty_like(phi)
-    grad[0] = -0.5 * (w * corr).sum() / hyp.lambda_w
-    # sum_ij m_ij (x_ik - x_jk)^2 = 2 sum_i x_ik^2 sum_j m_ij - 2 x_k' m x_k for symmetric m
-    m = w * slope
-    pair_sums = 2.0 * (m.sum(1) @ x**2 - np.einsum("ik,ik->k", x, m @ x))
+    grad[0] = -0.5 * w_corr / hyp.lambda_w
     grad[1:-1] = 0.5 * hyp.beta * pair_sums / hyp.lambda_w
-    grad[-1] = -0.5 * np.trace(w) / hyp.lambda_n
+    grad[-1] = -0.5 * w_trace / hyp.lambda_n
     lp, lp_grad = log_prior(phi)
     return nll - lp, grad - lp_grad
 
