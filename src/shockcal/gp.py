@@ -18,8 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg, optimize
 
-from shockcal.correlation import (FAMILIES, correlation_and_slope, cross_correlation, family_code,
-                                  gradient_sums, values_and_slopes)
+from shockcal.correlation import (
+    FAMILIES,
+    correlation_and_slope,
+    cross_correlation,
+    family_code,
+    gradient_sums,
+    values_and_slopes,
+)
 
 LAMBDA_W_PRIOR = (5.0, 5.0)         # Gamma(shape, rate) of the marginal precision
 RHO_PRIOR = (1.0, 0.1)              # Beta(a, b) of each rho_k
