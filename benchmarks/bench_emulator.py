@@ -4,7 +4,8 @@ Prints, with the load average next to every timing (the machine is shared): on t
 features (runs 0-499, real data), fit + K-fold + outer-check wall time and the RMSE and 90% coverage
 of each scheme; fit + K-fold on 1000 runs (the paper's design with a smooth synthetic 12-feature
 response, since FLAG features exist only for 500 runs); the time to predict mean and covariance of
-all 12 features at 1000 inputs with one and two BLAS threads.
+all 12 features at 1000 inputs on one and two threads; the same on our own runs when
+`results/features` holds them.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from threadpoolctl import threadpool_limits
 
 from shockcal.config import load_config
 from shockcal.emulator import CALIBRATION_FEATURES, fit_emulator, rmse_table
@@ -66,25 +66,38 @@ def main() -> None:
     cv.append(timed("outer check", lambda: emulator.cv_table("outer", margin=settings["outer_margin"])))
     table = rmse_table(pd.concat(cv, ignore_index=True))
     print(table[table["shot"] == "all"].to_string(index=False))
-    for threads in (1, 2):
-        with threadpool_limits(threads, user_api="blas"):
-            emulator.predict(inputs, SHOTS)
-            start = time.perf_counter()
-            emulator.predict(inputs, SHOTS)
-            print(f"  predict mean + cov of 12 features at 1000 inputs, {threads} BLAS thread(s): "
-                  f"{1e3 * (time.perf_counter() - start):.0f} ms ({load()})")
+    time_prediction(emulator, inputs)
     print("1000 runs x 12 features (synthetic response):")
+    fit_and_kfold(config, design, synthetic_features(design, config), inputs)
+    own = REPO / "results" / "features"
+    if all((own / f"{s}.parquet").is_file() for s in SHOTS):
+        print(f"our own runs ({own}):")
+        fit_and_kfold(config, pd.read_parquet(REPO / "results" / "design.parquet"),
+                      {s: pd.read_parquet(own / f"{s}.parquet") for s in SHOTS}, inputs)
+
+
+def fit_and_kfold(config, design, features, inputs) -> None:
+    """Fit (with its K-fold sd calibration) and the K-fold table, timed; then prediction."""
     start = time.perf_counter()
-    emulator = timed("fit", lambda: fit_emulator(config, design, synthetic_features(design, config)))
-    print(f"  ({len(emulator.blocks[0].model.gps)} components)")
-    timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"]))
-    print(f"  fit + K-fold: {time.perf_counter() - start:.1f} s ({load()})")
-    with threadpool_limits(1, user_api="blas"):
+    emulator = timed("fit", lambda: fit_emulator(config, design, features))
+    print(f"  ({len(emulator.blocks[0].model.gps)} components, {len(emulator.blocks[0].runs)} runs)")
+    folds = config["emulator"]["cv_folds"]
+    table = rmse_table(timed(f"{folds}-fold", lambda: emulator.cv_table("kfold", folds=folds)))
+    print(f"  fit + K-fold: {time.perf_counter() - start:.1f} s ({load()}); "
+          f"K-fold RMSE {table['rmse_m_s'].iloc[-1]:.2f} m/s, coverage {table['coverage90'].iloc[-1]:.3f}")
+    time_prediction(emulator, inputs)
+
+
+def time_prediction(emulator, inputs) -> None:
+    """Mean and covariance of all 12 features at the 1000 design points, on 1 and 2 threads."""
+    for threads in (1, 2):
+        for block in emulator.blocks:
+            block.model.settings.n_jobs = threads
         emulator.predict(inputs, SHOTS)
         start = time.perf_counter()
         emulator.predict(inputs, SHOTS)
-        print(f"  predict mean + cov at 1000 inputs, 1 BLAS thread: {1e3 * (time.perf_counter() - start):.0f} ms "
-              f"({load()})")
+        print(f"  predict mean + cov of 12 features at 1000 inputs, {threads} thread(s): "
+              f"{1e3 * (time.perf_counter() - start):.0f} ms ({load()})")
 
 
 if __name__ == "__main__":

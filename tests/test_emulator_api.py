@@ -79,16 +79,18 @@ def _problem(n=60, seed=6):
     return lower + x * (upper - lower), 100 * known_map(x) + NOISE * rng.normal(size=(n, 3)), lower, upper
 
 
-def test_kfold_equals_brute_force_refits():
+@pytest.mark.parametrize("warm_start", [True, False])
+def test_kfold_equals_brute_force_refits(warm_start):
     X, Y, lower, upper = _problem(n=24)
-    settings = Settings(family="matern52", n_starts=1, seed=3, calibrate_sd=False)
+    settings = Settings(family="matern52", n_starts=1, seed=3, calibrate_sd=False, cv_warm_start=warm_start)
     emulator = PCGPEmulator.fit(X, Y, lower, upper, settings)
     cv = emulator.cross_validate(4, seed=1)
     assert sorted(cv.rows) == list(range(24))
     folds = np.array_split(np.random.default_rng(1).permutation(24), 4)
+    starts = [gp.hyper for gp in emulator.gps] if warm_start else None
     for fold in folds:
         train = np.setdiff1d(np.arange(24), fold)
-        mean, cov = PCGPEmulator.fit(X[train], Y[train], lower, upper, settings).predict(X[fold])
+        mean, cov = PCGPEmulator.fit(X[train], Y[train], lower, upper, settings, starts).predict(X[fold])
         at = [np.flatnonzero(cv.rows == r)[0] for r in fold]
         np.testing.assert_allclose(cv.mean[at], mean, rtol=1e-10, atol=1e-10)
         np.testing.assert_allclose(cv.sd[at], np.sqrt(np.einsum("nff->nf", cov)), rtol=1e-10)

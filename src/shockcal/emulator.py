@@ -41,6 +41,7 @@ from shockcal.seeds import stream_seed
 FORMAT_VERSION = 3                  # 3: input powers for n and m (2 had the strain^n input only)
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
+PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
 log = logging.getLogger("shockcal.emulator")
@@ -124,10 +125,12 @@ class Settings:
     n_jobs: int = 1                # processes for the GP fits, threads for prediction (one BLAS thread each)
     cv_folds: int = 10             # K-fold of the sd calibration
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
+    cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
 
     @classmethod
     def from_config(cls, settings: dict, seed: int) -> Settings:
-        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd")
+        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd",
+                "cv_warm_start")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
 
 
@@ -141,11 +144,11 @@ class HeldOut:
     sd: np.ndarray
 
 
-def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence) -> Hyper:
+def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
     """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
-                                   family=settings.family, fit_mean=settings.fit_mean).hyper
+                                   family=settings.family, fit_mean=settings.fit_mean, start=start).hyper
 
 
 @cache
@@ -183,14 +186,16 @@ class PCGPEmulator:
         return (np.asarray(X, dtype=float) - self.lower) / (self.upper - self.lower)
 
     @classmethod
-    def fit(cls, X, Y, lower, upper, settings: Settings | None = None) -> PCGPEmulator:
-        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode.
+    def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None
+            ) -> PCGPEmulator:
+        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode (from
+        `starts`, one per component, if given; else from `settings.n_starts` starts).
 
         With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
         quantile of its K-fold |error| / sd over 1.645 (one factor per feature, never per run).
         """
         settings = settings or Settings()
-        model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))])[0]
+        model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
         if settings.calibrate_sd:
             held, folds = model._kfold(settings.cv_folds, settings.seed)
             model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
@@ -198,8 +203,9 @@ class PCGPEmulator:
         return model
 
     @classmethod
-    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets) -> list[PCGPEmulator]:
-        """One emulator per set of training rows, all GP fits in one (parallel) batch."""
+    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets, starts=None) -> list[PCGPEmulator]:
+        """One emulator per set of training rows, all GP fits in one (parallel) batch. `starts`:
+        hyperparameters to start component j's fit from (a refit of the same data's subsets)."""
         X, Y = np.asarray(X, dtype=float), np.asarray(Y, dtype=float)
         x_all = (X - np.asarray(lower, dtype=float)) / (np.asarray(upper, dtype=float) - np.asarray(lower, dtype=float))
         parts, tasks = [], []
@@ -219,7 +225,8 @@ class PCGPEmulator:
             fit_rows = (None if n <= settings.max_fit_runs else
                         np.sort(np.random.default_rng(subset_seed).choice(n, settings.max_fit_runs, replace=False)))
             parts.append((x, y, mean, scale, basis, residual.T @ residual / n))
-            tasks += [(x, weights[:, j], fit_rows, settings, component_seeds[j]) for j in range(p)]
+            tasks += [(x, weights[:, j], fit_rows, settings, component_seeds[j],
+                       starts[j] if starts is not None and j < len(starts) else None) for j in range(p)]
         if settings.n_jobs > 1:
             hypers = Parallel(n_jobs=settings.n_jobs)(delayed(_fit_hyper)(*t) for t in tasks)
         else:
@@ -244,16 +251,21 @@ class PCGPEmulator:
         return mean, z_cov * np.outer(self.scale * self.sd_factor, self.scale * self.sd_factor)
 
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Mean and variance (N, p) of each basis weight at scaled inputs x: the component GPs on
-        `settings.n_jobs` threads with one BLAS thread each (numba's correlation kernels release the
-        GIL; more BLAS threads per solve measured slower, docs/emulator.md "Speed")."""
-        with _blas_threads().limit(limits=1, user_api="blas"):
-            if self.settings.n_jobs > 1 and len(self.gps) > 1:
-                with ThreadPoolExecutor(self.settings.n_jobs) as pool:
-                    parts = list(pool.map(lambda gp: gp.predict(x), self.gps))
-            else:
-                parts = [gp.predict(x) for gp in self.gps]
-        return np.column_stack([m for m, _ in parts]), np.column_stack([v for _, v in parts])
+        """Mean and variance (N, p) of each basis weight at scaled inputs x, on `settings.n_jobs`
+        threads: the components' cross-covariances on Python threads (numba's kernel releases the
+        GIL), then their triangular solves on BLAS threads (scipy's LAPACK wrappers hold the GIL).
+        In batches of PREDICT_BATCH points, which bounds the memory of the cross-covariances."""
+        threads = self.settings.n_jobs
+        means, variances = [], []
+        for start in range(0, len(x), PREDICT_BATCH):
+            batch = x[start:start + PREDICT_BATCH]
+            with ThreadPoolExecutor(threads) as pool:
+                cross = list(pool.map(lambda gp: gp.prior_cov(batch, gp.x), self.gps))  # noqa: B023 (used at once)
+            with _blas_threads().limit(limits=threads, user_api="blas"):
+                parts = [gp.predict_from_cross_cov(k) for gp, k in zip(self.gps, cross)]
+            means.append(np.column_stack([m for m, _ in parts]))
+            variances.append(np.column_stack([v for _, v in parts]))
+        return np.concatenate(means), np.concatenate(variances)
 
     def loo(self) -> HeldOut:
         """Closed-form leave-one-out (hyperparameters and basis fixed): a fast diagnostic that flatters."""
@@ -299,8 +311,9 @@ class PCGPEmulator:
         return held
 
     def _held_out(self, scheme, tests, trains) -> HeldOut:
+        starts = [gp.hyper for gp in self.gps] if self.settings.cv_warm_start else None
         models = self._fit_many(self.x_train, self.y_train, np.zeros(len(self.lower)), np.ones(len(self.upper)),
-                                self.settings, trains)
+                                self.settings, trains, starts)
         rows = np.concatenate(tests)
         mean, sd = np.empty((len(rows), self.y_train.shape[1])), np.empty((len(rows), self.y_train.shape[1]))
         start = 0

@@ -32,6 +32,10 @@ RHO_PRIOR = (1.0, 0.1)              # Beta(a, b) of each rho_k
 LAMBDA_N_PRIOR = (3.0, 0.003)       # Gamma(shape, rate) of the nugget precision
 LOG_BOUNDS = {"lambda_w": (-6.0, 8.0), "beta": (np.log(1e-4), np.log(2e3)), "lambda_n": (0.0, 25.0)}
 KERNELS = FAMILIES
+# L-BFGS-B stops when a step improves the log posterior by less than this share of its value (about
+# 1e-3 at the emulator's ~700). Against scipy's default (2.2e-9): K-fold RMSE within 0.01 m/s, fits
+# 30% faster (docs/emulator.md "Speed")
+FIT_TOLERANCE = 1e-6
 
 
 def kernel(r2: np.ndarray, family: str, slope: bool = True):
@@ -55,6 +59,10 @@ class Hyper:
     beta: np.ndarray
     lambda_n: float
     mean: float = 0.0
+
+    def packed(self) -> np.ndarray:
+        """The optimiser's coordinates (log lambda_w, log beta_k, log lambda_n)."""
+        return np.log(np.concatenate([[self.lambda_w], self.beta, [self.lambda_n]]))
 
     @classmethod
     def unpack(cls, phi: np.ndarray, mean: float = 0.0) -> Hyper:
@@ -143,11 +151,12 @@ class GaussianProcess:
 
     @classmethod
     def fit(cls, x, y, n_starts: int = 4, seed: int | np.random.SeedSequence = 0, jitter: float = 1e-8, fit_rows=None,
-            family: str = "gaussian", fit_mean: bool = False) -> GaussianProcess:
+            family: str = "gaussian", fit_mean: bool = False, start: Hyper | None = None) -> GaussianProcess:
         """MAP hyperparameters (L-BFGS-B from several starts), then condition on all of (x, y).
 
         `fit_rows` restricts the hyperparameter fit to a subset of rows (for speed on large
-        designs); the returned process is conditioned on every row.
+        designs); the returned process is conditioned on every row. `start` (hyperparameters of a
+        related fit, e.g. on all rows when refitting a fold) is the one start, in place of `n_starts`.
         """
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         xs, ys = (x, y) if fit_rows is None else (x[fit_rows], y[fit_rows])
@@ -158,10 +167,12 @@ class GaussianProcess:
         while len(starts) < n_starts:
             starts.append(np.concatenate([[rng.normal(0, 0.5)], rng.uniform(np.log(0.05), np.log(20.0), dim),
                                           [rng.uniform(3.0, 12.0)]]))
+        if start is not None:
+            starts, n_starts = [np.clip(start.packed(), *np.array(bounds).T)], 1
         best = None
         for phi0 in starts[:max(n_starts, 1)]:
             res = optimize.minimize(neg_log_posterior, phi0, args=(xs, ys, family, jitter, fit_mean), jac=True,
-                                    method="L-BFGS-B", bounds=bounds)
+                                    method="L-BFGS-B", bounds=bounds, options={"ftol": FIT_TOLERANCE})
             if best is None or res.fun < best.fun:
                 best = res
         hyper = Hyper.unpack(best.x)
@@ -176,8 +187,13 @@ class GaussianProcess:
 
     def predict(self, x_new: np.ndarray, include_nugget: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance at `x_new` (the nugget is part of a new observation)."""
-        k = self.prior_cov(np.asarray(x_new, dtype=float), self.x)
-        mean = self.hyper.mean + k @ self.alpha
+        return self.predict_from_cross_cov(self.prior_cov(np.asarray(x_new, dtype=float), self.x), include_nugget)
+
+    def predict_from_cross_cov(self, k: np.ndarray, include_nugget: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """`predict` given k = prior_cov(x_new, x_train) (so that callers can build k on other threads).
+        The mean is an einsum, not a BLAS product: with two BLAS threads, a matrix-vector product
+        just before the triangular solve made the solve twice as slow (measured)."""
+        mean = self.hyper.mean + np.einsum("ij,j->i", k, self.alpha)
         v = linalg.solve_triangular(self.factor[0], k.T, lower=True, check_finite=False)
         var = 1.0 / self.hyper.lambda_w - np.einsum("ij,ij->j", v, v)
         if include_nugget:
