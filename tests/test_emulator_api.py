@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.emulator import PCGPEmulator, Settings
+from shockcal.emulator import PCGPEmulator, Settings, Switch
 from shockcal.gp import KERNELS, GaussianProcess, kernel
 
 NOISE = 0.05
@@ -102,13 +102,35 @@ def test_sd_calibration_is_one_factor_per_feature_from_the_kfold():
     calibrated = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=5))
     held = raw.cross_validate(5)
     z = np.abs(held.mean - Y[held.rows]) / held.sd
-    np.testing.assert_allclose(calibrated.sd_factor, np.quantile(z, 0.9, axis=0) / 1.6449)
+    np.testing.assert_allclose(calibrated.sd_factor, np.tile(np.quantile(z, 0.9, axis=0) / 1.6449, (2, 1)))
     (m0, c0), (m1, c1) = raw.predict(X[:5]), calibrated.predict(X[:5])
     np.testing.assert_array_equal(m0, m1)
     sd0, sd1 = np.sqrt(np.einsum("nff->nf", c0)), np.sqrt(np.einsum("nff->nf", c1))
-    np.testing.assert_allclose(sd1, sd0 * calibrated.sd_factor)
+    np.testing.assert_allclose(sd1, sd0 * calibrated.sd_factor[0])
     cv = calibrated.cross_validate(5)                     # each fold scaled by the other folds' factors
     assert np.all(cv.sd != held.sd) and np.array_equal(cv.mean, held.mean)
+
+
+def test_a_switch_gets_its_own_sd_factor_and_its_bands_hold():
+    # a known truth: output 0 scatters ten times more where output0 / output1 > 0.9 (a "single-wave" side)
+    rng = np.random.default_rng(11)
+    X = rng.uniform(size=(300, 2))
+    clean = np.column_stack([0.5 + 0.6 * X[:, 0] + 0.1 * X[:, 1], np.ones(300)])
+    past = clean[:, 0] > 0.9
+    Y = clean + np.column_stack([np.where(past, 0.05, 0.005) * rng.normal(size=300), 0.005 * rng.normal(size=300)])
+    settings = Settings(n_starts=1, cv_folds=5, seed=2)
+    switch = [Switch(0, 1, [0])]
+    with_switch = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), settings, switches=switch)
+    without = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), settings)
+    assert with_switch.sd_factor[1, 0] > 2 * with_switch.sd_factor[0, 0]
+    for model, holds in ((with_switch, True), (without, False)):
+        held = model.kfold
+        inside = np.abs(held.mean[:, 0] - Y[held.rows, 0]) <= 1.6449 * held.sd[:, 0]
+        coverage = [inside[past[held.rows]].mean(), inside[~past[held.rows]].mean()]
+        assert (min(coverage) >= 0.8 and max(coverage) <= 0.98) == holds, coverage
+    mean, cov = with_switch.predict(np.array([[0.1, 0.5], [0.9, 0.5]]))     # below and past the switch
+    sd = np.sqrt(cov[:, 0, 0])
+    assert sd[1] > 3 * sd[0]
 
 
 def test_arrays_api_fits_predicts_saves_and_loads(tmp_path):

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from scipy.special import expit
 from threadpoolctl import ThreadpoolController, threadpool_limits
 
 from shockcal.config import STRENGTH_INPUTS, shot_config
@@ -41,6 +42,8 @@ from shockcal.seeds import stream_seed
 FORMAT_VERSION = 3                  # 3: input powers for n and m (2 had the strain^n input only)
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
+SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
+SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
 PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
@@ -126,12 +129,24 @@ class Settings:
     cv_folds: int = 10             # K-fold of the sd calibration
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
     cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
+    switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
 
     @classmethod
     def from_config(cls, settings: dict, seed: int) -> Settings:
         keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd",
-                "cv_warm_start")
+                "cv_warm_start", "switch_ratio")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
+
+
+@dataclass
+class Switch:
+    """A regime switch of the outputs: past mean[numerator] / mean[denominator] = switch_ratio
+    (columns of Y; e.g. v_elastic / v_plastic near 1, a single-wave trace), the `affected` columns
+    get sd factors of their own, since the emulator's error there differs from the bulk's."""
+
+    numerator: int
+    denominator: int
+    affected: list[int]
 
 
 @dataclass
@@ -166,13 +181,15 @@ class PCGPEmulator:
     """
 
     def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings, sd_factor=None):
+                 settings: Settings, sd_factor=None, switches=None):
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
         self.residual_cov = np.asarray(residual_cov)
         self.x_train, self.y_train = np.asarray(x_train, dtype=float), np.asarray(y_train, dtype=float)
         self.settings = settings
-        self.sd_factor = np.ones(len(self.mean)) if sd_factor is None else np.asarray(sd_factor, dtype=float)
+        # sd factors (2, F): row 0 in the usual regime, row 1 past a switch (see `switch_weight`)
+        self.sd_factor = np.ones((2, len(self.mean))) if sd_factor is None else np.asarray(sd_factor, dtype=float)
+        self.switches: list[Switch] = list(switches or [])
         self.kfold: HeldOut | None = None          # the K-fold of the sd calibration, kept for reporting
         self.weights = self.project((self.y_train - self.mean) / self.scale)
         self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h, family=settings.family)
@@ -186,16 +203,19 @@ class PCGPEmulator:
         return (np.asarray(X, dtype=float) - self.lower) / (self.upper - self.lower)
 
     @classmethod
-    def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None
-            ) -> PCGPEmulator:
+    def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None,
+            switches: list[Switch] | None = None) -> PCGPEmulator:
         """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode (from
         `starts`, one per component, if given; else from `settings.n_starts` starts).
 
         With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
-        quantile of its K-fold |error| / sd over 1.645 (one factor per feature, never per run).
+        quantile of its K-fold |error| / sd over 1.645: one factor per feature, never per run, and
+        a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
+        traces), when there are at least SWITCH_MIN_RUNS of them.
         """
         settings = settings or Settings()
         model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
+        model.switches = list(switches or [])
         if settings.calibrate_sd:
             held, folds = model._kfold(settings.cv_folds, settings.seed)
             model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
@@ -248,7 +268,25 @@ class PCGPEmulator:
         w_mean, w_var = self._predict_weights(np.ascontiguousarray(x, dtype=float))
         z_cov = np.einsum("nj,jf,jg->nfg", w_var, self.basis, self.basis) + self.residual_cov
         mean = self.mean + (w_mean @ self.basis) * self.scale
-        return mean, z_cov * np.outer(self.scale * self.sd_factor, self.scale * self.sd_factor)
+        sd_scale = self.scale * self.sd_factors(mean)                              # (N, F)
+        return mean, z_cov * sd_scale[:, :, None] * sd_scale[:, None, :]
+
+    def switch_weight(self, mean: np.ndarray) -> np.ndarray:
+        """(N, F) weight of the switched regime at predicted means: for each switch's columns a
+        logistic step in mean[numerator] / mean[denominator] at `settings.switch_ratio` (width
+        SWITCH_WIDTH), smooth so that the calibration likelihood stays smooth; 0 elsewhere."""
+        weight = np.zeros_like(mean)
+        if self.settings.switch_ratio:
+            for sw in self.switches:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    ratio = mean[:, sw.numerator] / mean[:, sw.denominator]
+                step = expit((np.nan_to_num(ratio, nan=0.0) - self.settings.switch_ratio) / SWITCH_WIDTH)
+                weight[:, sw.affected] = step[:, None]
+        return weight
+
+    def sd_factors(self, mean: np.ndarray) -> np.ndarray:
+        """(N, F) sd factors at predicted means, blending the usual and the switched regime's."""
+        return _blend(self.sd_factor, self.switch_weight(mean))
 
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance (N, p) of each basis weight at scaled inputs x, on `settings.n_jobs`
@@ -274,8 +312,9 @@ class PCGPEmulator:
         for j, gp in enumerate(self.gps):
             w_mean[:, j], w_var[:, j] = gp.loo()
         z_var = w_var @ self.basis**2 + np.diag(self.residual_cov)
+        mean = self.mean + (w_mean @ self.basis) * self.scale
         return HeldOut("loo_closed_form", np.arange(len(self.y_train)),
-                       self.mean + (w_mean @ self.basis) * self.scale, np.sqrt(z_var) * self.scale * self.sd_factor)
+                       mean, np.sqrt(z_var) * self.scale * self.sd_factors(mean))
 
     def cross_validate(self, k: int = 10, seed: int | None = None) -> HeldOut:
         """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold.
@@ -307,7 +346,7 @@ class PCGPEmulator:
             empty = np.empty((0, self.y_train.shape[1]))
             return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
         held = self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
-        held.sd *= self.sd_factor
+        held.sd *= self.sd_factors(held.mean)
         return held
 
     def _held_out(self, scheme, tests, trains) -> HeldOut:
@@ -330,7 +369,7 @@ class PCGPEmulator:
         return {f"{prefix}{k}": v for k, v in arrays.items()}
 
     def to_json(self) -> dict:
-        return {"settings": asdict(self.settings),
+        return {"settings": asdict(self.settings), "switches": [asdict(sw) for sw in self.switches],
                 "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
                                      "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
 
@@ -339,7 +378,7 @@ class PCGPEmulator:
         hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
         return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
-                   arrays[f"{prefix}sd_factor"])
+                   arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]])
 
     def save(self, path) -> Path:
         """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
@@ -360,9 +399,21 @@ class PCGPEmulator:
 
 
 def _sd_factor(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> np.ndarray:
-    """Per feature: 90% quantile of |error| / sd over the rows `use` of a held-out set, over 1.645."""
+    """(2, F) sd factors from the rows `use` of a held-out set: per feature, the 90% quantile of
+    |error| / sd over 1.645, in the usual regime (row 0) and past a switch (row 1; the usual one
+    where fewer than SWITCH_MIN_RUNS held-out values are past it)."""
     z = np.abs(held.mean[use] - model.y_train[held.rows[use]]) / held.sd[use]
-    return np.quantile(z, 0.9, axis=0) / Z90
+    switched = model.switch_weight(held.mean[use]) > 0.5
+    factors = np.tile(np.quantile(z, 0.9, axis=0) / Z90, (2, 1))
+    for col in np.flatnonzero(switched.sum(0) >= SWITCH_MIN_RUNS):
+        past = switched[:, col]
+        factors[:, col] = np.quantile(z[~past, col], 0.9) / Z90, np.quantile(z[past, col], 0.9) / Z90
+    return factors
+
+
+def _blend(factors: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """(N, F) factors: the usual regime's, moved towards the switched one's by weight (N, F)."""
+    return factors[0] + weight * (factors[1] - factors[0])
 
 
 def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
@@ -370,7 +421,8 @@ def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
     fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
     sd = held.sd.copy()
     for j in range(len(folds)):
-        sd[fold_of == j] *= _sd_factor(model, held, fold_of != j)
+        here = fold_of == j
+        sd[here] *= _blend(_sd_factor(model, held, ~here), model.switch_weight(held.mean[here]))
     return HeldOut(held.scheme, held.rows, held.mean, sd)
 
 
@@ -565,12 +617,20 @@ def fit_emulator(config: dict, design: pd.DataFrame, features: dict[str, pd.Data
         _check_training_inputs(table, input_map, label)
         settings = Settings.from_config(config["emulator"], stream_seed(config["study"]["seed"], "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
-                                 settings)
+                                 settings, switches=single_wave_switches(len(block_shots)))
         log.info("emulator %s: %d runs, %d inputs, %d of %d components, %s correlation", "+".join(block_shots),
                  len(table), len(input_map.names), len(model.gps), len(columns), settings.family)
         blocks.append(Block(input_map, block_shots, table["run"].to_numpy(), model))
     bounds = {k: (v["min"], v["max"]) for k, v in config["inputs"].items()}
     return Emulator(structure, blocks, bounds, {s: _shot_terms(config, s) for s in shots})
+
+
+def single_wave_switches(n_shots: int) -> list[Switch]:
+    """Per shot (features in CALIBRATION_FEATURES order, shot after shot): v_elastic / v_plastic
+    near 1 marks a single-wave trace, where v_elastic and v_slope1 change meaning."""
+    k = len(CALIBRATION_FEATURES)
+    elastic, plastic = CALIBRATION_FEATURES.index("v_elastic"), CALIBRATION_FEATURES.index("v_plastic")
+    return [Switch(k * i + elastic, k * i + plastic, list(range(k * i, k * (i + 1)))) for i in range(n_shots)]
 
 
 def rmse_table(cv: pd.DataFrame) -> pd.DataFrame:
