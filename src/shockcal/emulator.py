@@ -119,7 +119,7 @@ def _box_map(config, names, terms) -> InputMap:
 class Settings:
     """How a PCGPEmulator is fitted (config `emulator`, or keyword arguments from a notebook)."""
 
-    family: str = "matern52"       # correlation family (gp.KERNELS)
+    family: str = "matern52"       # correlation family (correlation.FAMILIES)
     fit_mean: bool = True          # per-component constant mean (GLS), else zero
     n_components: float = 0.999    # integer count, or variance fraction in (0, 1)
     n_starts: int = 2              # L-BFGS-B starts per GP

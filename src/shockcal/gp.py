@@ -3,7 +3,7 @@
     cov(w(t), w(t')) = c(r^2) / lambda_w  +  delta(t, t') / lambda_n,   r^2 = sum_k beta_k (t_k - t'_k)^2
 
 with a constant mean (estimated by generalised least squares, or fixed at 0). Correlation families
-c (`KERNELS`): `gaussian` exp(-r^2), Higdon et al.'s prod_k rho_k^(4 (t_k - t'_k)^2) with
+c (`correlation.FAMILIES`): `gaussian` exp(-r^2), Higdon et al.'s prod_k rho_k^(4 (t_k - t'_k)^2) with
 rho_k = exp(-beta_k / 4); `matern52` and `matern32`, the Matern functions of r. Priors (SPEC
 section 5): lambda_w ~ Gamma(5, 5), rho_k = exp(-beta_k / 4) ~ Beta(1, 0.1) for every family, nugget
 precision lambda_n ~ Gamma(3, 0.003) as in GPM/SA. The mode is found in the coordinates
@@ -19,30 +19,20 @@ import numpy as np
 from scipy import linalg, optimize
 
 from shockcal.correlation import (
-    FAMILIES,
     correlation_and_slope,
     cross_correlation,
     family_code,
     gradient_sums,
-    values_and_slopes,
 )
 
 LAMBDA_W_PRIOR = (5.0, 5.0)         # Gamma(shape, rate) of the marginal precision
 RHO_PRIOR = (1.0, 0.1)              # Beta(a, b) of each rho_k
 LAMBDA_N_PRIOR = (3.0, 0.003)       # Gamma(shape, rate) of the nugget precision
 LOG_BOUNDS = {"lambda_w": (-6.0, 8.0), "beta": (np.log(1e-4), np.log(2e3)), "lambda_n": (0.0, 25.0)}
-KERNELS = FAMILIES
 # L-BFGS-B stops when a step improves the log posterior by less than this share of its value (about
 # 1e-3 at the emulator's ~700). Against scipy's default (2.2e-9): K-fold RMSE within 0.01 m/s, fits
 # 30% faster (docs/emulator.md "Speed")
 FIT_TOLERANCE = 1e-6
-
-
-def kernel(r2: np.ndarray, family: str, slope: bool = True):
-    """Correlation c(r^2) and, with `slope`, its derivative dc/d(r^2), for a correlation family."""
-    r2 = np.asarray(r2, dtype=float)
-    c, dc = values_and_slopes(r2.ravel(), family_code(family))
-    return (c.reshape(r2.shape), dc.reshape(r2.shape)) if slope else c.reshape(r2.shape)
 
 
 def correlation(a: np.ndarray, b: np.ndarray, beta: np.ndarray, family: str = "gaussian") -> np.ndarray:
