@@ -53,15 +53,6 @@ def square_distances_to(a_i, b_t, beta, out):
 
 
 @njit(cache=True, nogil=True)
-def values_and_slopes(r2, family):
-    """c and dc/d(r^2) at each of a 1-D array of r^2."""
-    c, slope = np.empty_like(r2), np.empty_like(r2)
-    for i in range(len(r2)):
-        c[i], slope[i] = value_and_slope(r2[i], family)
-    return c, slope
-
-
-@njit(cache=True, nogil=True)
 def cross_correlation(a, b, beta, family):
     """Correlation matrix between the rows of a (m, d) and b (n, d)."""
     b_t = np.ascontiguousarray(b.T)
@@ -76,14 +67,19 @@ def cross_correlation(a, b, beta, family):
 
 @njit(cache=True, nogil=True)
 def correlation_and_slope(x, beta, family):
-    """Correlation matrix of the rows of x (n, d) with itself, and its slope dc/d(r^2) at each pair."""
+    """Correlation matrix of the rows of x (n, d) with itself, and its slope dc/d(r^2) at each pair
+    (each pair evaluated once, then mirrored)."""
     n = x.shape[0]
     x_t = np.ascontiguousarray(x.T)
-    r2 = np.empty((n, n))
+    r2 = np.empty(n)
+    corr, slope = np.empty((n, n)), np.empty((n, n))
     for i in range(n):
-        square_distances_to(x[i], x_t, beta, r2[i])
-    c, slope = values_and_slopes(r2.ravel(), family)
-    return c.reshape((n, n)), slope.reshape((n, n))
+        square_distances_to(x[i], x_t, beta, r2)
+        for j in range(i + 1):
+            c, s = value_and_slope(r2[j], family)
+            corr[i, j] = corr[j, i] = c
+            slope[i, j] = slope[j, i] = s
+    return corr, slope
 
 
 @njit(cache=True, nogil=True)

@@ -14,6 +14,7 @@ smooth (the Beta(1, 0.1) density itself is unbounded at rho = 1).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy import linalg, optimize
@@ -137,7 +138,6 @@ class GaussianProcess:
         cov.flat[::len(self.y) + 1] += 1.0 / hyper.lambda_n + jitter
         self.factor = linalg.cho_factor(cov, lower=True)
         self.alpha = linalg.cho_solve(self.factor, self.y - hyper.mean)
-        self.inv_cov = _inverse_from_cholesky(self.factor[0])
 
     @classmethod
     def fit(cls, x, y, n_starts: int = 4, seed: int | np.random.SeedSequence = 0, jitter: float = 1e-8, fit_rows=None,
@@ -195,6 +195,12 @@ class GaussianProcess:
         x_new = np.asarray(x_new, dtype=float)
         k = self.prior_cov(x_new, self.x)
         return self.hyper.mean + k @ self.alpha, self.prior_cov(x_new, x_new) - k @ self.inv_cov @ k.T
+
+    @cached_property
+    def inv_cov(self) -> np.ndarray:
+        """K^-1, built on first use (only LOO and joint prediction need it, not the folds' refits or
+        a loaded emulator's predictions)."""
+        return _inverse_from_cholesky(self.factor[0])
 
     def loo(self) -> tuple[np.ndarray, np.ndarray]:
         """Leave-one-out predictive mean and variance in closed form (hyperparameters fixed)."""
