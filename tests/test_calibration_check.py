@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import re
 
@@ -70,6 +71,15 @@ def small_config(paper_config):
     return paper_config
 
 
+@pytest.fixture(scope="module")
+def three_toy_trials(paper_config_readonly):
+    """Three synthetic-truth trials on the toy emulator, seed 4, run once for the tests that read them."""
+    config = copy.deepcopy(paper_config_readonly)
+    config["calibration"].update(n_live=200, n_eff=500, draws=2000)
+    emu = ShotEmulator(config, shots=["toy"], emulator_sd=0.3)
+    return emu, config, synthetic_truth(emu, ["toy"], config, trials=3, seed=4, n_live=100, n_eff=300)
+
+
 def test_log_posterior_matches_the_gaussian_formula(small_config):
     emu = ShotEmulator(small_config)
     names = emu.required_inputs(["104S"])
@@ -95,9 +105,8 @@ def test_shot_without_emulator_is_rejected(small_config):
         calibrate(emu, ["106S"], obs, small_config, n_samples=100)
 
 
-def test_synthetic_truth_table_and_binomial_band(small_config):
-    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
-    trials = synthetic_truth(emu, ["toy"], small_config, trials=3, seed=4, n_live=100, n_eff=300)
+def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
+    _, _, trials = three_toy_trials
     assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess"]
     assert len(trials) == 3 * 3 and (trials["q05"] < trials["q95"]).all() and (trials["ess"] >= 300).all()
     table = coverage_table(pd.concat([trials] * 34, ignore_index=True).assign(trial=np.repeat(np.arange(102), 3)))
@@ -105,11 +114,10 @@ def test_synthetic_truth_table_and_binomial_band(small_config):
     assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
 
 
-def test_synthetic_truth_in_batches_equals_one_run(small_config):
+def test_synthetic_truth_in_batches_equals_one_run(three_toy_trials):
     # each trial has its own random stream: the workflow's batches of trials are independent jobs
-    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
-    whole = synthetic_truth(emu, ["toy"], small_config, trials=3, seed=4, n_live=100, n_eff=300)
-    batches = [synthetic_truth(emu, ["toy"], small_config, trials=range(*r), seed=4, n_live=100, n_eff=300)
+    emu, config, whole = three_toy_trials
+    batches = [synthetic_truth(emu, ["toy"], config, trials=range(*r), seed=4, n_live=100, n_eff=300)
                for r in [(2, 3), (0, 2)]]
     merged = pd.concat(batches).sort_values("trial", kind="stable").reset_index(drop=True)
     pd.testing.assert_frame_equal(merged, whole)
