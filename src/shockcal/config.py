@@ -15,6 +15,7 @@ import yaml
 
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.plausibility import check_observed
+from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 
@@ -147,7 +148,7 @@ def end_time_us(config: dict, shot: dict) -> float:
     material = config["material"]
     c0_cm_us = math.sqrt(material["eos"]["c1_Mbar"] / material["rho0_g_cc"])
     window = shot["analysis"]["window_after_arrival_us"]
-    return shot["target_mm"] * 0.1 / c0_cm_us + window + AUTO_END_MARGIN_US
+    return shot["target_mm"] * MM_TO_CM / c0_cm_us + window + AUTO_END_MARGIN_US
 
 
 def shot_inputs(config: dict, shot: str) -> list[str]:

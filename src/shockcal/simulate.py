@@ -17,10 +17,9 @@ import pandas as pd
 from shockcal.config import shot_config, shot_inputs
 from shockcal.design import shot_parameters
 from shockcal.hydro import run_shot
+from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.simulate")
-MBAR_TO_GPA = 100.0
-CM_US_TO_M_S = 1.0e4
 DIAGNOSTICS = ["max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
                "n_steps", "wall_time_s"]
 UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_rate_per_us": "1/us",

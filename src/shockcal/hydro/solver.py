@@ -2,17 +2,21 @@
 
 Units inside: cm, us, g/cc, Mbar (1 Mbar = 1 g/cc (cm/us)^2); specific energy in (cm/us)^2.
 
-Mesh: nodes 0..N+1, cells 0..N, cell j between nodes j and j+1. The flyer's cells are 0..nf-1,
+Mesh (`Nodes`, `Cells`): nodes 0..N+1, cells 0..N, cell j between nodes j and j+1. The flyer's cells are 0..nf-1,
 the target's nf+1..N; cell nf is the contact gap between the flyer's rear node nf and the
 target's front node nf+1 (no mass, no stress, its length is the gap). Both outer nodes are free
-surfaces. Each step (leapfrog):
-1. nodes: u += dt (sigma_right - sigma_left) / m_node, sigma = -(P + q) + s;
-2. contact: if the gap would close, the two interface nodes take their common momentum velocity
-   and the energy an impact dissipates goes to the interface cells; under tension the nodes
-   separate, which opens the interface;
-3. cells: length from the node velocities, strain rate, artificial viscosity (compression only),
-   elastic trial deviator and Johnson-Cook radial return, energy equation, EOS;
-4. time step: CFL on the longitudinal sound speed, viscosity included, growth limited to 10%.
+surfaces. Each step (leapfrog), one kernel per line:
+1. `accelerate_nodes`: u += dt (sigma_right - sigma_left) / m_node, sigma = -(P + q) + s;
+2. `close_contact`: if the gap would close, the two interface nodes take their common momentum
+   velocity and the energy an impact dissipates goes to the interface cells; under tension the
+   nodes separate, which opens the interface;
+3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
+   only), elastic trial deviator and Johnson-Cook radial return, energy equation, EOS;
+4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
+   limited to 10%.
+The material, strength and numerics parameters travel as named tuples in code units
+(`Material`, `Strength`, `Numerics`; `shockcal.units` converts). Kernels that loop over the mesh
+take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
 so its nodes keep their initial velocities bit for bit, and the active window grows by one node
 when the stress of the cell beyond it becomes non-zero.
@@ -23,6 +27,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -30,19 +35,102 @@ from numba import njit
 from shockcal.config import end_time_us
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
 from shockcal.hydro.strength import flow_stress, hardening, radial_return, thermal_factor
+from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
-J_PER_KG = 1.0e-8          # 1 J/kg in (cm/us)^2
-PER_S = 1.0e-6             # 1 /s in 1/us
-CM_US_TO_M_S = 1.0e4
 STATUS_OK, STATUS_NEGATIVE_VOLUME, STATUS_NAN, STATUS_DT_COLLAPSE = 0, 1, 2, 3
 FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "NaN in cell state",
                    STATUS_DT_COLLAPSE: "time step collapsed"}
 DT_FLOOR_US = 1.0e-12
+DT_GROWTH = 1.1            # the time step grows by at most 10% a step
+
+
+class Material(NamedTuple):
+    """Flyer and target material: Mie-Grueneisen EOS and thermal constants (code units)."""
+
+    rho0: float            # g/cc
+    c1: float              # Mbar
+    c2: float              # Mbar
+    c3: float              # Mbar
+    gamma0: float
+    T_ref: float           # K
+    T_melt: float          # K
+    cv: float              # (cm/us)^2 / K
+
+
+class Strength(NamedTuple):
+    """Shear modulus and Johnson-Cook parameters of one run (Mbar, -, 1/us)."""
+
+    G: float
+    A: float
+    B: float
+    C: float
+    n: float
+    m: float
+    rate_ref: float
+
+
+class Numerics(NamedTuple):
+    """Artificial viscosity and time stepping (us)."""
+
+    q1: float
+    q2: float
+    cfl: float
+    dt_initial: float
+    dt_max: float
+
+
+class Nodes(NamedTuple):
+    """Node velocity (cm/us) and lumped mass per unit area (g/cm^2), nodes 0..N+1."""
+
+    u: np.ndarray
+    mass: np.ndarray
+
+
+class Cells(NamedTuple):
+    """Cell state, cells 0..N (cell `gap` is the contact gap: no mass, its length is the gap).
+
+    `flow_floor` is a lower bound of the cell's flow stress, valid while its temperature stays at or
+    below `floor_T`: a trial stress inside it is elastic without evaluating pow/log (the rate factor
+    is >= 1, the thermal factor falls with T, the hardening grows with eps_p)."""
+
+    mass: np.ndarray       # g/cm^2
+    length: np.ndarray     # cm
+    E: np.ndarray          # specific internal energy, (cm/us)^2
+    P: np.ndarray          # pressure, Mbar
+    s: np.ndarray          # deviator s_xx, Mbar
+    sigma: np.ndarray      # total stress -(P + q) + s, Mbar
+    eps_p: np.ndarray      # equivalent plastic strain
+    hard: np.ndarray       # A + B eps_p^n, Mbar
+    flow_floor: np.ndarray  # Mbar
+    floor_T: np.ndarray    # K
 
 
 @njit(cache=True, error_model="numpy")
-def _total_energy(u, node_mass, E, cell_mass):
+def initial_mesh(nf, nt, dx, velocity, strength, material):
+    """Flyer (cells 0..nf-1) at `velocity` against a target at rest (cells nf+1..N), touching."""
+    N = nf + nt
+    gap = nf
+    mass = np.full(N + 1, material.rho0 * dx)
+    mass[gap] = 0.0
+    length = np.full(N + 1, dx)
+    length[gap] = 0.0
+    hard = np.full(N + 1, hardening(strength.A, strength.B, strength.n, 0.0))
+    cells = Cells(mass, length, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
+                  np.zeros(N + 1), hard, np.zeros(N + 1), np.full(N + 1, np.inf))
+    u = np.zeros(N + 2)
+    u[: nf + 1] = velocity
+    node_mass = np.empty(N + 2)
+    node_mass[0] = 0.5 * mass[0]
+    for i in range(1, N + 1):
+        node_mass[i] = 0.5 * (mass[i - 1] + mass[i])
+    node_mass[N + 1] = 0.5 * mass[N]
+    return Nodes(u, node_mass), cells
+
+
+@njit(cache=True, error_model="numpy")
+def total_energy(nodes, cells):
     """Kinetic + internal energy per unit area (Mbar cm)."""
+    u, node_mass, E, cell_mass = nodes.u, nodes.mass, cells.E, cells.mass
     kinetic = 0.0
     for i in range(u.shape[0]):
         kinetic += 0.5 * node_mass[i] * u[i] * u[i]
@@ -53,153 +141,185 @@ def _total_energy(u, node_mass, E, cell_mass):
 
 
 @njit(cache=True, error_model="numpy")
-def _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, approach_speed):
-    """Interface nodes in contact move together (momentum conserved). A collision between nodes
-    that approached at `approach_speed` before this step (the impact) dissipates
-    0.5 mu approach_speed^2; that energy goes into the two interface cells, as a shock would put it.
-    Nodes already moving together lose nothing: merging them is the combined node's momentum update."""
-    a, b = gap, gap + 1
-    common = (node_mass[a] * u[a] + node_mass[b] * u[b]) / (node_mass[a] + node_mass[b])
-    u[a] = common
-    u[b] = common
-    reduced_mass = node_mass[a] * node_mass[b] / (node_mass[a] + node_mass[b])
-    dissipated = 0.5 * reduced_mass * approach_speed * approach_speed
-    for j in (gap - 1, gap + 1):
-        dE = 0.5 * dissipated / cell_mass[j]
-        E[j] += dE
-        P[j] += g_rho0 * dE
-        sigma[j] -= g_rho0 * dE
+def accelerate_nodes(nodes, sigma, lo, hi, dt):
+    """Momentum: u += dt (sigma_right - sigma_left) / m_node; outside the mesh the stress is 0."""
+    u, node_mass = nodes.u, nodes.mass
+    N = sigma.shape[0] - 1
+    for i in range(lo, hi + 1):
+        left = sigma[i - 1] if i > 0 else 0.0
+        right = sigma[i] if i <= N else 0.0
+        u[i] += dt * (right - left) / node_mass[i]
 
 
 @njit(cache=True, error_model="numpy")
-def _simulate(nf, nt, dx, velocity, G, A, B, C, n, m, rho0, c1, c2, c3, gamma0, T_ref, T_melt, cv,
-              rate_ref, q1, q2, cfl, dt_initial, dt_max, t_out):
+def close_contact(nodes, cells, gap, dt, approach_speed, g_rho0):
+    """The gap's length from its nodes' velocities. If it would close, the interface nodes move
+    together (momentum conserved); an impact (nodes that approached at `approach_speed` before
+    this step) dissipates 0.5 mu approach_speed^2, which goes into the two interface cells as a
+    shock would put it. Nodes already moving together lose nothing: merging them is the combined
+    node's momentum update. Under tension the nodes separate and the gap opens."""
+    u, m = nodes.u, nodes.mass
+    a, b = gap, gap + 1
+    if cells.length[gap] + dt * (u[b] - u[a]) <= 0.0:
+        common = (m[a] * u[a] + m[b] * u[b]) / (m[a] + m[b])
+        u[a] = common
+        u[b] = common
+        reduced_mass = m[a] * m[b] / (m[a] + m[b])
+        dissipated = 0.5 * reduced_mass * approach_speed * approach_speed
+        for j in (gap - 1, gap + 1):
+            dE = 0.5 * dissipated / cells.mass[j]
+            cells.E[j] += dE
+            cells.P[j] += g_rho0 * dE
+            cells.sigma[j] -= g_rho0 * dE
+    cells.length[gap] = max(cells.length[gap] + dt * (u[b] - u[a]), 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def artificial_viscosity(du, volume, c_long, q1, q2):
+    """q = (q2 du^2 - q1 c_L du) / V in compression (du < 0), else 0 (Mbar)."""
+    return (q2 * du * du - q1 * c_long * du) / volume if du < 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def signal_speed(du, c_long, q1, q2):
+    """The CFL signal speed: a + sqrt(a^2 + c_L^2), a = q1 c_L + 2 q2 |du| the viscous speed in
+    compression; c_L otherwise (cm/us)."""
+    if du < 0.0:
+        a_visc = q1 * c_long + 2.0 * q2 * abs(du)
+        return a_visc + math.sqrt(a_visc * a_visc + c_long * c_long)
+    return c_long
+
+
+@njit(cache=True, error_model="numpy")
+def johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material):
+    """(s, d eps_p, thermal factor): the trial deviator returned onto the Johnson-Cook yield surface
+    at the cell's temperature (K) and current strain rate (1/us) if outside it."""
+    thermal = thermal_factor(strength.m, (T_cell - material.T_ref) * (1.0 / (material.T_melt - material.T_ref)))
+    flow = flow_stress(hard, thermal, strength.C, strain_rate, strength.rate_ref)
+    s_new, d_eps = radial_return(s_trial, flow, strength.G)
+    return s_new, d_eps, thermal
+
+
+@njit(cache=True, error_model="numpy")
+def energy_update(E, P, p_cold, q, dV, work_dev, g_rho0):
+    """dE = -(P + q) dV + deviatoric work, P trapezoid-implicit: P_new = p_cold + g_rho0 E_new."""
+    return (E - (0.5 * (P + p_cold) + q) * dV + work_dev) / (1.0 + 0.5 * g_rho0 * dV)
+
+
+@njit(cache=True, error_model="numpy")
+def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, peaks):
+    """Advance the active cells (those touching nodes lo..hi, the gap excepted) by dt: length and
+    strain rate from the node velocities, EOS sound speed, artificial viscosity, elastic trial and
+    Johnson-Cook return (skipped while the trial lies inside the cell's flow-stress floor), energy
+    and pressure. Returns (status, failed cell or -1, max CFL signal rate c / L (1/us), at least
+    cfl / dt_max); a failed cell keeps its state. `peaks` holds the target's running maxima of
+    plastic rate (1/us, a diagnostic only), temperature (K) and plastic strain."""
+    u = nodes.u
+    mass, length, E, P, s, sigma = cells.mass, cells.length, cells.E, cells.P, cells.s, cells.sigma
+    eps_p, hard, flow_floor, floor_T = cells.eps_p, cells.hard, cells.flow_floor, cells.floor_T
+    N = E.shape[0] - 1
+    four_thirds_G = 4.0 * strength.G / 3.0
+    g_rho0 = material.gamma0 * material.rho0
+    max_signal_rate = numerics.cfl / numerics.dt_max
+    for j in range(max(lo - 1, 0), min(hi, N) + 1):
+        if j == gap:
+            continue
+        du = u[j + 1] - u[j]
+        new_length = length[j] + dt * du
+        if not new_length > 0.0:
+            return STATUS_NEGATIVE_VOLUME, j, max_signal_rate
+        strain_rate = 2.0 * du / (length[j] + new_length)
+        volume = new_length / mass[j]              # specific volume 1/rho
+        mu = 1.0 / (material.rho0 * volume) - 1.0
+        c_bulk_sq = bulk_sound_speed_sq(mu, P[j], volume, material.rho0, material.c1, material.c2, material.c3,
+                                        material.gamma0)
+        c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
+        q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
+        s_trial = s[j] + four_thirds_G * strain_rate * dt
+        T_cell = material.T_ref + E[j] / material.cv
+        if 1.5 * abs(s_trial) <= flow_floor[j] and T_cell <= floor_T[j]:
+            s_new, d_eps = s_trial, 0.0
+        else:
+            s_new, d_eps, thermal = johnson_cook_return(s_trial, T_cell, strain_rate, hard[j], strength, material)
+            if d_eps > 0.0:
+                eps_p[j] += d_eps
+                hard[j] = hardening(strength.A, strength.B, strength.n, eps_p[j])
+            flow_floor[j] = hard[j] * thermal      # the rate factor is >= 1, thermal(T) falls with T
+            floor_T[j] = T_cell
+        dV = dt * du / mass[j]
+        work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
+        p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)
+        E_new = energy_update(E[j], P[j], p_cold, q, dV, work_dev, g_rho0)
+        P_new = p_cold + g_rho0 * E_new
+        if not (E_new == E_new and P_new == P_new):
+            return STATUS_NAN, j, max_signal_rate
+        E[j] = E_new
+        P[j] = P_new
+        s[j] = s_new
+        length[j] = new_length
+        sigma[j] = -(P_new + q) + s_new
+        if j > gap:
+            peaks[0] = max(peaks[0], d_eps / dt)
+            peaks[1] = max(peaks[1], material.T_ref + E_new / material.cv)
+            peaks[2] = max(peaks[2], eps_p[j])
+        max_signal_rate = max(max_signal_rate, signal_speed(du, c_long, numerics.q1, numerics.q2) / new_length)
+    return STATUS_OK, -1, max_signal_rate
+
+
+@njit(cache=True, error_model="numpy")
+def grow_window(sigma, lo, hi):
+    """The active nodes grow by one where the cell beyond them has started to move (stress != 0)."""
+    N = sigma.shape[0] - 1
+    if lo > 0 and sigma[lo - 1] != 0.0:
+        lo -= 1
+    if hi < N + 1 and sigma[hi] != 0.0:
+        hi += 1
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
     """Run to t_out[-1]; returns (v_free_surface, energy_at_outputs, status, fail_cell, fail_time,
     n_steps, max_plastic_rate, max_T, max_eps_p), the maxima over the target's cells."""
+    nodes, cells = initial_mesh(nf, nt, dx, velocity, strength, material)
+    u = nodes.u
     N = nf + nt
     gap = nf
-    cell_mass = np.full(N + 1, rho0 * dx)
-    cell_mass[gap] = 0.0
-    length = np.full(N + 1, dx)
-    length[gap] = 0.0
-    E = np.zeros(N + 1)
-    P = np.zeros(N + 1)
-    q = np.zeros(N + 1)
-    s = np.zeros(N + 1)
-    sigma = np.zeros(N + 1)
-    eps_p = np.zeros(N + 1)
-    hard = np.full(N + 1, hardening(A, B, n, 0.0))
-    # a lower bound of each cell's flow stress, valid while its temperature stays <= floor_T:
-    # a trial stress inside it is elastic without evaluating pow/log (JC rate factor >= 1, thermal
-    # factor falling with T, hardening growing with eps_p)
-    flow_floor = np.zeros(N + 1)
-    floor_T = np.full(N + 1, np.inf)
-    u = np.zeros(N + 2)
-    u[: nf + 1] = velocity
-    node_mass = np.empty(N + 2)
-    node_mass[0] = 0.5 * cell_mass[0]
-    for i in range(1, N + 1):
-        node_mass[i] = 0.5 * (cell_mass[i - 1] + cell_mass[i])
-    node_mass[N + 1] = 0.5 * cell_mass[N]
-
+    g_rho0 = material.gamma0 * material.rho0
     n_out = t_out.shape[0]
     v_out = np.zeros(n_out)
     energy_out = np.zeros(n_out)
-    energy_out[0] = _total_energy(u, node_mass, E, cell_mass)
+    energy_out[0] = total_energy(nodes, cells)
+    peaks = np.array([0.0, material.T_ref, 0.0])
     k_out = 1
     t = 0.0
-    dt = dt_initial
+    dt = numerics.dt_initial
     u_fs_prev, t_fs_prev = 0.0, 0.0
     lo, hi = gap, gap + 1                       # active nodes
     steps = 0
-    max_rate, max_T, max_eps = 0.0, T_ref, 0.0
-    four_thirds_G = 4.0 * G / 3.0
-    g_rho0 = gamma0 * rho0
-    inv_T_range = 1.0 / (T_melt - T_ref)
-
     while k_out < n_out:
-        # 1. momentum
         approach_speed = u[gap] - u[gap + 1]
-        for i in range(lo, hi + 1):
-            left = sigma[i - 1] if i > 0 else 0.0
-            right = sigma[i] if i <= N else 0.0
-            u[i] += dt * (right - left) / node_mass[i]
-        # 2. contact
-        closing = length[gap] + dt * (u[gap + 1] - u[gap])
-        if closing <= 0.0:
-            _collide(u, node_mass, E, P, sigma, cell_mass, gap, g_rho0, max(approach_speed, 0.0))
-        length[gap] = max(length[gap] + dt * (u[gap + 1] - u[gap]), 0.0)
-        # 3. cells
-        max_signal_rate = cfl / dt_max         # (signal speed / cell length), the CFL limit is cfl / max
-        for j in range(max(lo - 1, 0), min(hi, N) + 1):
-            if j == gap:
-                continue
-            du = u[j + 1] - u[j]
-            old_length = length[j]
-            new_length = old_length + dt * du
-            if not new_length > 0.0:
-                return v_out, energy_out, STATUS_NEGATIVE_VOLUME, j, t, steps, max_rate, max_T, max_eps
-            strain_rate = 2.0 * du / (old_length + new_length)
-            volume = new_length / cell_mass[j]       # specific volume 1/rho
-            mu = 1.0 / (rho0 * volume) - 1.0
-            c_bulk_sq = bulk_sound_speed_sq(mu, P[j], volume, rho0, c1, c2, c3, gamma0)
-            c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
-            q_new = (q2 * du * du - q1 * c_long * du) / volume if du < 0.0 else 0.0
-            # strength: elastic trial, Johnson-Cook flow stress, radial return
-            s_trial = s[j] + four_thirds_G * strain_rate * dt
-            T_cell = T_ref + E[j] / cv
-            if 1.5 * abs(s_trial) <= flow_floor[j] and T_cell <= floor_T[j]:
-                s_new, d_eps = s_trial, 0.0
-            else:
-                thermal = thermal_factor(m, (T_cell - T_ref) * inv_T_range)
-                flow = flow_stress(hard[j], thermal, C, strain_rate, rate_ref)
-                s_new, d_eps = radial_return(s_trial, flow, G)
-                if d_eps > 0.0:
-                    eps_p[j] += d_eps
-                    hard[j] = hardening(A, B, n, eps_p[j])
-                flow_floor[j] = hard[j] * thermal     # the rate factor is >= 1, thermal(T) falls with T
-                floor_T[j] = T_cell
-            # energy: dE = -(P + q) dV + s_mean * strain_rate * dt / rho, P implicit (trapezoid)
-            dV = dt * du / cell_mass[j]
-            work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
-            p_cold = cold_pressure(mu, c1, c2, c3)
-            E_new = (E[j] - (0.5 * (P[j] + p_cold) + q_new) * dV + work_dev) / (1.0 + 0.5 * g_rho0 * dV)
-            P[j] = p_cold + g_rho0 * E_new
-            if not (E_new == E_new and P[j] == P[j]):
-                return v_out, energy_out, STATUS_NAN, j, t, steps, max_rate, max_T, max_eps
-            E[j] = E_new
-            q[j] = q_new
-            s[j] = s_new
-            length[j] = new_length
-            sigma[j] = -(P[j] + q_new) + s_new
-            if j > gap:
-                max_rate = max(max_rate, d_eps / dt)      # plastic rate: a diagnostic only
-                max_T = max(max_T, T_ref + E_new / cv)
-                max_eps = max(max_eps, eps_p[j])
-            # 4. time step: dt = cfl L / (a + sqrt(a^2 + c^2)), a the viscous signal speed
-            a_visc = (q1 * c_long + 2.0 * q2 * abs(du)) if du < 0.0 else 0.0
-            signal = a_visc + math.sqrt(a_visc * a_visc + c_long * c_long) if du < 0.0 else c_long
-            max_signal_rate = max(max_signal_rate, signal / new_length)
-        dt_next = cfl / max_signal_rate
-        # grow the active window where a cell beyond it has started to move
-        if lo > 0 and sigma[lo - 1] != 0.0:
-            lo -= 1
-        if hi < N + 1 and sigma[hi] != 0.0:
-            hi += 1
+        accelerate_nodes(nodes, cells.sigma, lo, hi, dt)
+        close_contact(nodes, cells, gap, dt, max(approach_speed, 0.0), g_rho0)
+        status, cell, max_signal_rate = update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics,
+                                                     peaks)
+        if status != STATUS_OK:
+            return v_out, energy_out, status, cell, t, steps, peaks[0], peaks[1], peaks[2]
+        lo, hi = grow_window(cells.sigma, lo, hi)
         # free-surface velocity (time-centred at t + dt/2), linearly interpolated onto t_out
         t_mid = t + 0.5 * dt
         while k_out < n_out and t_out[k_out] <= t_mid:
             w = (t_out[k_out] - t_fs_prev) / (t_mid - t_fs_prev)
             v_out[k_out] = u_fs_prev + w * (u[N + 1] - u_fs_prev)
-            energy_out[k_out] = _total_energy(u, node_mass, E, cell_mass)
+            energy_out[k_out] = total_energy(nodes, cells)
             k_out += 1
         u_fs_prev, t_fs_prev = u[N + 1], t_mid
         t += dt
         steps += 1
-        dt = min(dt_next, 1.1 * dt)
+        dt = min(numerics.cfl / max_signal_rate, DT_GROWTH * dt)
         if dt < DT_FLOOR_US:
-            return v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, max_rate, max_T, max_eps
-    return v_out, energy_out, STATUS_OK, -1, t, steps, max_rate, max_T, max_eps
+            return v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2]
+    return v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2]
 
 
 @dataclass
@@ -219,23 +339,37 @@ class RunResult:
     energy_history: np.ndarray = field(default=None, repr=False)
 
 
+def material_of(config: dict) -> Material:
+    """The study config's `material` section in code units."""
+    material, eos = config["material"], config["material"]["eos"]
+    return Material(float(material["rho0_g_cc"]), float(eos["c1_Mbar"]), float(eos["c2_Mbar"]), float(eos["c3_Mbar"]),
+                    float(eos["gamma0"]), float(material["T_ref_K"]), float(material["T_melt_K"]),
+                    float(material["cv_J_per_kg_K"]) * J_PER_KG_TO_CODE)
+
+
+def numerics_of(config: dict) -> Numerics:
+    """The study config's `hydro` section's viscosity and time-step settings (us)."""
+    hydro = config["hydro"]
+    return Numerics(float(hydro["q_linear"]), float(hydro["q_quadratic"]), float(hydro["cfl"]),
+                    float(hydro["dt_initial_us"]), float(hydro["dt_max_us"]))
+
+
 def run_shot(params, shot: dict, config: dict, end_us: float | None = None) -> RunResult:
     """Simulate one shot to `end_us` (default: `end_time_us(config, shot)`). `params` is a
     shockcal.design.ShotParameters (Mbar, cm/us)."""
-    material, hydro, eos = config["material"], config["hydro"], config["material"]["eos"]
-    dx = hydro["cell_size_um"] * 1e-4
-    nf = max(int(round(shot["flyer_mm"] * 0.1 / dx)), 1)
-    nt = max(int(round(shot["target_mm"] * 0.1 / dx)), 1)
-    dt_out = hydro["output_dt_ns"] * 1e-3
+    hydro = config["hydro"]
+    dx = hydro["cell_size_um"] * UM_TO_CM
+    nf = max(int(round(shot["flyer_mm"] * MM_TO_CM / dx)), 1)
+    nt = max(int(round(shot["target_mm"] * MM_TO_CM / dx)), 1)
+    dt_out = hydro["output_dt_ns"] * NS_TO_US
     end_us = end_time_us(config, shot) if end_us is None else end_us
     t_out = np.arange(int(round(end_us / dt_out)) + 1) * dt_out
+    strength = Strength(float(params.shear_modulus_Mbar), float(params.A), float(params.B), float(params.C),
+                        float(params.n), float(params.m),
+                        float(config["material"]["strain_rate_ref_per_s"]) * PER_S_TO_PER_US)
     start = time.perf_counter()
-    v, energy, status, cell, t_fail, steps, max_rate, max_T, max_eps = _simulate(
-        nf, nt, dx, params.velocity_cm_us, params.shear_modulus_Mbar, params.A, params.B, params.C, params.n,
-        params.m, material["rho0_g_cc"], eos["c1_Mbar"], eos["c2_Mbar"], eos["c3_Mbar"], eos["gamma0"],
-        material["T_ref_K"], material["T_melt_K"], material["cv_J_per_kg_K"] * J_PER_KG,
-        material["strain_rate_ref_per_s"] * PER_S, hydro["q_linear"], hydro["q_quadratic"], hydro["cfl"],
-        hydro["dt_initial_us"], hydro["dt_max_us"], t_out)
+    v, energy, status, cell, t_fail, steps, max_rate, max_T, max_eps = simulate(
+        nf, nt, dx, float(params.velocity_cm_us), strength, material_of(config), numerics_of(config), t_out)
     wall = time.perf_counter() - start
     reason = ""
     if status != STATUS_OK:
