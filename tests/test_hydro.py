@@ -11,7 +11,14 @@ from scipy.optimize import brentq
 
 from shockcal.design import ShotParameters
 from shockcal.hydro import run_shot
-from shockcal.hydro.strength import flow_stress, hardening, radial_return, rate_factor, thermal_factor
+from shockcal.hydro.strength import (
+    flow_stress,
+    hardening,
+    radial_return,
+    rate_factor,
+    thermal_factor,
+    thermal_factor_below,
+)
 
 DATA = Path(__file__).parent / "data"
 
@@ -200,6 +207,36 @@ def test_c0_traces_identical_to_the_lagged_rate_code(paper_config):
     for name, params in cases.items():
         result = run_shot(params, shot, paper_config)
         assert np.array_equal(result.v_m_s, stored[name]), name
+
+
+def test_flow_stress_floors_change_no_trace(paper_config):
+    """The kernel skips the Johnson-Cook evaluation where a cell's trial stress lies inside a lower
+    bound of its flow stress (the flow-stress floors, 2026-11-24): traces stored from the code before
+    them (rate term on, small m, n = 0, strong and hot cases) are reproduced bit for bit."""
+    stored = np.load(DATA / "traces_before_flow_floors.npz")
+    cases = {"gray_104": ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),
+             "soft_m_106": ShotParameters(0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30),
+             "n0_105": ShotParameters(0.0072, 0.003, 0.0159, 0.0, 1.10, 0.03549, 0.28),
+             "rate_hot_106": ShotParameters(0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),
+             "strong_104": ShotParameters(0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
+    shot = _setup(paper_config, 1.0, 1.5, 0.6)
+    for name, params in cases.items():
+        assert np.array_equal(run_shot(params, shot, paper_config).v_m_s, stored[name]), name
+
+
+def test_thermal_factor_bound_lies_below_the_factor():
+    """thermal_factor_below(m, T*, thermal_factor(m, T*), dT*) <= thermal_factor(m, T* + dT*) for every
+    m of the box and beyond, T* from cold to near melt, and margins of 0.1-10 K (T_melt - T_ref = 600 K)."""
+    worst_gap = np.inf
+    for m in [0.0, 0.01, 0.05, 0.3, 1.0, 1.7, 3.0, 6.0]:
+        for T in np.geomspace(1e-6, 0.99, 60):
+            for dT in [0.1 / 600, 1.0 / 600, 10.0 / 600]:
+                bound = thermal_factor_below(m, T, thermal_factor(m, T), dT)
+                exact = thermal_factor(m, T + dT)
+                assert 0.0 <= bound <= exact, (m, T, dT, bound, exact)
+                worst_gap = min(worst_gap, exact - bound)
+    assert worst_gap >= 0.0
+    assert thermal_factor_below(1.2, 0.0, 1.0, 0.01) == 0.0              # cold cell: no bound
 
 
 @pytest.mark.parametrize("cell_size_um", [8.0, 4.0, 2.0])

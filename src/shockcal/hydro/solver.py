@@ -34,13 +34,23 @@ from numba import njit
 
 from shockcal.config import end_time_us
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
-from shockcal.hydro.strength import flow_stress, hardening, radial_return, thermal_factor
+from shockcal.hydro.strength import (
+    equivalent_strain_rate,
+    flow_stress,
+    hardening,
+    radial_return,
+    rate_factor,
+    thermal_factor,
+    thermal_factor_below,
+)
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 STATUS_OK, STATUS_NEGATIVE_VOLUME, STATUS_NAN, STATUS_DT_COLLAPSE = 0, 1, 2, 3
 FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "NaN in cell state",
                    STATUS_DT_COLLAPSE: "time step collapsed"}
 DT_FLOOR_US = 1.0e-12
+FLOOR_MARGIN_K = 1.0       # a cell's flow-stress floor holds up to this much above the temperature it was set at
+FLOOR_SLACK = 1.0 - 1e-12  # keeps the floor below the flow stress through rounding (products in another order)
 DT_GROWTH = 1.1            # the time step grows by at most 10% a step
 
 
@@ -89,9 +99,12 @@ class Nodes(NamedTuple):
 class Cells(NamedTuple):
     """Cell state, cells 0..N (cell `gap` is the contact gap: no mass, its length is the gap).
 
-    `flow_floor` is a lower bound of the cell's flow stress, valid while its temperature stays at or
-    below `floor_T`: a trial stress inside it is elastic without evaluating pow/log (the rate factor
-    is >= 1, the thermal factor falls with T, the hardening grows with eps_p)."""
+    `flow_floor` is a lower bound of the cell's rate-free flow stress (A + B eps_p^n)(1 - T*^m),
+    valid while its temperature stays at or below `floor_T`, the temperature of its last full
+    evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
+    is one valid up to `FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
+    so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
+    a pow or log; inside the floor times the rate factor (one log), elastic without a pow."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
@@ -102,6 +115,7 @@ class Cells(NamedTuple):
     eps_p: np.ndarray      # equivalent plastic strain
     hard: np.ndarray       # A + B eps_p^n, Mbar
     flow_floor: np.ndarray  # Mbar
+    floor_hotter: np.ndarray  # Mbar
     floor_T: np.ndarray    # K
 
 
@@ -116,7 +130,7 @@ def initial_mesh(nf, nt, dx, velocity, strength, material):
     length[gap] = 0.0
     hard = np.full(N + 1, hardening(strength.A, strength.B, strength.n, 0.0))
     cells = Cells(mass, length, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
-                  np.zeros(N + 1), hard, np.zeros(N + 1), np.full(N + 1, np.inf))
+                  np.zeros(N + 1), hard, np.zeros(N + 1), np.zeros(N + 1), np.full(N + 1, np.inf))
     u = np.zeros(N + 2)
     u[: nf + 1] = velocity
     node_mass = np.empty(N + 2)
@@ -191,13 +205,34 @@ def signal_speed(du, c_long, q1, q2):
 
 
 @njit(cache=True, error_model="numpy")
+def homologous_temperature(T, material):
+    """T* = (T - T_ref) / (T_melt - T_ref)."""
+    return (T - material.T_ref) * (1.0 / (material.T_melt - material.T_ref))
+
+
+@njit(cache=True, error_model="numpy")
 def johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material):
-    """(s, d eps_p, thermal factor): the trial deviator returned onto the Johnson-Cook yield surface
-    at the cell's temperature (K) and current strain rate (1/us) if outside it."""
-    thermal = thermal_factor(strength.m, (T_cell - material.T_ref) * (1.0 / (material.T_melt - material.T_ref)))
-    flow = flow_stress(hard, thermal, strength.C, strain_rate, strength.rate_ref)
-    s_new, d_eps = radial_return(s_trial, flow, strength.G)
-    return s_new, d_eps, thermal
+    """(s, d eps_p, thermal factor, a lower bound of it FLOOR_MARGIN_K hotter): the trial deviator
+    returned onto the Johnson-Cook yield surface at the cell's temperature (K) and current strain
+    rate (1/us) if outside it, and the thermal factors of the cell's floors."""
+    homologous = homologous_temperature(T_cell, material)
+    thermal = thermal_factor(strength.m, homologous)
+    s_new, d_eps = radial_return(s_trial, flow_stress(hard, thermal, strength.C, strain_rate, strength.rate_ref),
+                                 strength.G)
+    margin = FLOOR_MARGIN_K * (1.0 / (material.T_melt - material.T_ref))
+    return s_new, d_eps, thermal, thermal_factor_below(strength.m, homologous, thermal, margin)
+
+
+@njit(cache=True, error_model="numpy")
+def inside_floor(equivalent_stress, flow_floor, strain_rate, strength):
+    """Whether a trial von Mises stress is provably elastic: inside the rate-free floor, or (one log)
+    inside the floor times the Johnson-Cook rate factor. A negative floor means none holds."""
+    if equivalent_stress <= flow_floor:
+        return True
+    if flow_floor <= 0.0 or strength.C == 0.0:     # no floor, or no rate term to raise it
+        return False
+    return equivalent_stress <= flow_floor * rate_factor(strength.C, equivalent_strain_rate(strain_rate),
+                                                         strength.rate_ref)
 
 
 @njit(cache=True, error_model="numpy")
@@ -216,7 +251,8 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
     plastic rate (1/us, a diagnostic only), temperature (K) and plastic strain."""
     u = nodes.u
     mass, length, E, P, s, sigma = cells.mass, cells.length, cells.E, cells.P, cells.s, cells.sigma
-    eps_p, hard, flow_floor, floor_T = cells.eps_p, cells.hard, cells.flow_floor, cells.floor_T
+    eps_p, hard, flow_floor, floor_hotter, floor_T = (cells.eps_p, cells.hard, cells.flow_floor, cells.floor_hotter,
+                                                      cells.floor_T)
     N = E.shape[0] - 1
     four_thirds_G = 4.0 * strength.G / 3.0
     g_rho0 = material.gamma0 * material.rho0
@@ -237,15 +273,19 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
         T_cell = material.T_ref + E[j] / material.cv
-        if 1.5 * abs(s_trial) <= flow_floor[j] and T_cell <= floor_T[j]:
+        floor = flow_floor[j] if T_cell <= floor_T[j] else (
+            floor_hotter[j] if T_cell <= floor_T[j] + FLOOR_MARGIN_K else -1.0)
+        if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
             s_new, d_eps = s_trial, 0.0
         else:
-            s_new, d_eps, thermal = johnson_cook_return(s_trial, T_cell, strain_rate, hard[j], strength, material)
+            s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, hard[j],
+                                                                        strength, material)
             if d_eps > 0.0:
                 eps_p[j] += d_eps
                 hard[j] = hardening(strength.A, strength.B, strength.n, eps_p[j])
-            flow_floor[j] = hard[j] * thermal      # the rate factor is >= 1, thermal(T) falls with T
             floor_T[j] = T_cell
+            flow_floor[j] = FLOOR_SLACK * hard[j] * thermal
+            floor_hotter[j] = FLOOR_SLACK * hard[j] * thermal_hotter
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)

@@ -22,6 +22,8 @@ import math
 
 from numba import njit
 
+BOUND_ROUNDING = 1e-12     # absolute allowance for rounding in thermal_factor_below
+
 
 @njit(cache=True, error_model="numpy")
 def hardening(A, B, n, eps_p):
@@ -60,6 +62,24 @@ def thermal_factor(m, homologous_T):
     if homologous_T >= 1.0 or m == 0.0:
         return 0.0
     return 1.0 - homologous_T**m
+
+
+@njit(cache=True, error_model="numpy")
+def thermal_factor_below(m, homologous_T, thermal, d_homologous_T):
+    """A lower bound of thermal_factor(m, T* + dT*) from thermal = thermal_factor(m, T*), without a
+    pow: with p = T*^m = 1 - thermal and x = dT*/T*, (1 + x)^m <= 1 + m x for m <= 1 (Bernoulli)
+    and <= exp(m x) <= 1 / (1 - m x) for m x < 1; 0 (no bound) otherwise or at T* <= 0. The bound
+    is lowered by BOUND_ROUNDING, far above the rounding of factors <= 1 (about 1e-15)."""
+    if homologous_T <= 0.0:
+        return 0.0
+    x = d_homologous_T / homologous_T
+    if m <= 1.0:
+        growth = 1.0 + m * x
+    elif m * x < 1.0:
+        growth = 1.0 / (1.0 - m * x)
+    else:
+        return 0.0
+    return max(1.0 - (1.0 - thermal) * growth - BOUND_ROUNDING, 0.0)
 
 
 @njit(cache=True, error_model="numpy")
