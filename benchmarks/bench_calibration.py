@@ -9,7 +9,9 @@ For each calibration (joint, then each shot) on a fitted emulator and measured f
              against the reference as a share of the box (5/25/50/75/95%), the mass at A > 800 MPa;
   smc        (--smc) smcpy's adaptive SMC with --smc-particles and --smc-moves, the same measures;
   emcee      (--emcee) an emcee ensemble of the same length in likelihood evaluations, with
-             ArviZ's R-hat and bulk ESS, as a yardstick.
+             ArviZ's R-hat and bulk ESS, as a yardstick;
+  dynesty    (--dynesty N_LIVE) static nested sampling with random slices, the independent
+             cross-check of the reference (--replicates 0 skips the default runs).
 Goal (issue 14): ESS >= 1000 per parameter, worst quantile error <= 0.02 of the box, <= 60 s wall.
 
     .venv/bin/python benchmarks/bench_calibration.py --emulator DIR [--observed TABLE] [--only joint]
@@ -105,6 +107,26 @@ def run_smc(problem, particles: int, moves: int, seed: int):
     return points, time.perf_counter() - start, time.process_time() - cpu, evaluations[0]
 
 
+def run_dynesty(problem, n_live: int, seed: int):
+    """dynesty's static nested sampling (multi-ellipsoid bounds, random slices; one point per call):
+    the independent cross-check of the reference. Equal-weight draws, wall and CPU seconds, calls,
+    and its log evidence with its error."""
+    import dynesty
+    from dynesty.utils import resample_equal
+
+    rng = np.random.default_rng(seed)
+    start, cpu = time.perf_counter(), time.process_time()
+    sampler = dynesty.NestedSampler(lambda x: float(problem.log_likelihood(x[None])[0]),
+                                    lambda u: problem.prior_transform(u[None])[0], problem.ndim, nlive=n_live,
+                                    bound="multi", sample="rslice", rstate=rng)
+    sampler.run_nested(dlogz=0.1, print_progress=False)
+    result = sampler.results
+    weights = np.exp(result.logwt - result.logz[-1])
+    points = resample_equal(result.samples, weights / weights.sum(), rstate=rng)
+    return (points, time.perf_counter() - start, time.process_time() - cpu, int(np.sum(result.ncall)),
+            float(result.logz[-1]), float(result.logzerr[-1]))
+
+
 def report(label, runs, ref, names, width):
     """Print the measures of replicate runs [(points, wall, cpu, evaluations), ...]."""
     means = np.array([points.mean(axis=0) for points, *_ in runs])
@@ -166,6 +188,8 @@ def main(argv=None) -> int:
     parser.add_argument("--smc-particles", type=int, default=4000)
     parser.add_argument("--smc-moves", type=int, default=5)
     parser.add_argument("--emcee", action="store_true", help="also run the emcee yardstick (60,000 evaluations)")
+    parser.add_argument("--dynesty", type=int, default=0, metavar="N_LIVE",
+                        help="also run dynesty with N_LIVE live points (random slices), the independent cross-check")
     args = parser.parse_args(argv)
     if not (Path(args.emulator) / "emulator.json").is_file():
         print(f"skipped: no emulator at {args.emulator} (shockcal emulate, or the study)")
@@ -183,8 +207,13 @@ def main(argv=None) -> int:
         ref = reference(problem, name, Path(args.reference_dir), args.reference_live, args.reference_eff)
         width = np.append(problem.upper - problem.lower, LAMBDA_Y_SPAN)
         print(f"== {name}: {len(names)} parameters")
-        report("default", [run_default(problem, settings, seed) for seed in range(1, args.replicates + 1)],
-               ref, names, width)
+        if args.replicates:
+            report("default", [run_default(problem, settings, seed) for seed in range(1, args.replicates + 1)],
+                   ref, names, width)
+        if args.dynesty:
+            *run, log_z, log_z_error = run_dynesty(problem, args.dynesty, seed=1)
+            report(f"dynesty ({args.dynesty} live, slices)", [run], ref, names, width)
+            print(f"  dynesty log evidence {log_z:.3f} +- {log_z_error:.3f}")
         if args.smc:
             report("smc", [run_smc(problem, args.smc_particles, args.smc_moves, seed=1)], ref, names, width)
         if args.emcee:
