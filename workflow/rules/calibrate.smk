@@ -18,6 +18,7 @@ rule calibrate:
         name="|".join(CALIBRATIONS),
     conda:
         "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],
@@ -51,6 +52,7 @@ rule calibration_check_batch:
         batch=r"\d+",
     conda:
         "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
         calibration=config["calibration"],
         sd_fraction=config["observed"]["sd_fraction"],

@@ -103,6 +103,7 @@ rule predict_emulator:
         f"{BENCHMARKS}/predict/emulator.tsv"
     conda:
         "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
