@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.calibration import weighted_quantiles
+from shockcal.calibration import quantile_mcse, weighted_quantiles
 
 REPO = Path(__file__).resolve().parents[1]
 QUANTILES = [0.05, 0.25, 0.5, 0.75, 0.95]
@@ -72,6 +72,21 @@ def quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> float
     return worst
 
 
+def quantile_z(draws, ref: pd.DataFrame, names) -> tuple[float, str]:
+    """Worst |quantile - reference quantile| in units of the Monte Carlo standard error of that
+    difference (both runs' `quantile_mcse`), and where: is the error the sampling noise of the ESS?"""
+    worst, where = 0.0, ""
+    w_ref = ref["weight"].to_numpy()
+    for j, name in enumerate(names):
+        x_ref, x = ref[name].to_numpy(), draws.points[:, j]
+        difference = weighted_quantiles(x, draws.weights, QUANTILES) - weighted_quantiles(x_ref, w_ref, QUANTILES)
+        error = np.hypot(quantile_mcse(x, draws.weights, QUANTILES), quantile_mcse(x_ref, w_ref, QUANTILES))
+        z = np.abs(difference) / error
+        if z.max() > worst:
+            worst, where = float(z.max()), f"{name} q{round(100 * QUANTILES[int(np.argmax(z))]):02d}"
+    return worst, where
+
+
 def run_default(problem, settings, seed):
     """The configured nautilus run: equal-weight draws (resampled), wall and CPU seconds, evaluations."""
     from shockcal.sampler import nested_sample
@@ -80,7 +95,7 @@ def run_default(problem, settings, seed):
     draws = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings["n_live"],
                           settings["n_eff"], seed)
     points = draws.points[draws.resample(20000, np.random.default_rng(seed))]
-    return points, time.perf_counter() - start, time.process_time() - cpu, draws.n_likelihood
+    return points, time.perf_counter() - start, time.process_time() - cpu, draws.n_likelihood, draws
 
 
 def run_smc(problem, particles: int, moves: int, seed: int):
@@ -134,6 +149,7 @@ def report(label, runs, ref, names, width):
     errors = [quantile_error(points, ref, names, width) for points, *_ in runs]
     tip = [np.mean(points[:, names.index("A")] > TIP_A_MBAR) for points, *_ in runs] if "A" in names else [np.nan]
     wall = np.median([r[1] for r in runs])
+    weighted = [r[4] for r in runs if len(r) > 4]
     print(f"  {label} x{len(runs)}: wall {wall:.1f} s median, CPU {np.median([r[2] for r in runs]):.1f} s, "
           f"{int(np.median([r[3] for r in runs]))} evaluations ({load()})")
     if len(runs) > 1:
@@ -143,6 +159,9 @@ def report(label, runs, ref, names, width):
     print(f"  {label} worst quantile error vs reference: median {np.median(errors):.4f}, max {np.max(errors):.4f} "
           f"of the box; mass at A > 800 MPa {np.mean(tip):.3f} (reference "
           f"{ref['weight'][ref['A'] > TIP_A_MBAR].sum() if 'A' in names else np.nan:.3f})")
+    for draws in weighted:
+        z, where = quantile_z(draws, ref, names)
+        print(f"  {label} worst quantile error in Monte Carlo standard errors of the difference: {z:.1f} ({where})")
 
 
 def run_emcee(problem, evaluations: int, seed: int):
