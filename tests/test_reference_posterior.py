@@ -1,0 +1,60 @@
+"""The documented shape of the default study's reference joint posterior (docs/calibration.md,
+"Reference posterior of the default study"), checked on its saved draws
+(tests/data/reference_posterior_joint.parquet, made by tests/data/make_reference_posterior.py).
+
+Each claim is tested with a margin of several binomial standard errors of the 6,000 draws, so the
+test fails if a remade reference changes the claim, not if it only moves within its sampling noise.
+"""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+DRAWS = Path(__file__).parent / "data" / "reference_posterior_joint.parquet"
+TIP_A_MBAR = 0.008  # A > 800 MPa
+
+
+@pytest.fixture(scope="module")
+def draws() -> pd.DataFrame:
+    return pd.read_parquet(DRAWS)
+
+
+def density(x: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Histogram density and its binomial standard error per bin."""
+    counts, _ = np.histogram(x, edges)
+    share = counts / len(x)
+    width = np.diff(edges)
+    return share / width, np.sqrt(share * (1 - share) / len(x)) / width
+
+
+def test_the_a_above_800_mpa_tip_holds_about_an_eighth_of_the_mass(draws):
+    tip = np.mean(draws["A"] > TIP_A_MBAR)
+    se = np.sqrt(tip * (1 - tip) / len(draws))
+    assert abs(tip - 0.12) < 4 * se, f"tip mass {tip:.3f}"
+    # the tip is the small-m arm: m there is below 0.15 for most of its mass
+    assert np.median(draws.loc[draws["A"] > TIP_A_MBAR, "m"]) < 0.15
+
+
+def test_n_is_bimodal(draws):
+    """A mode at n < 0.1, a dip at 0.2-0.3 and a second mode at 0.4-0.5: both peaks stand above the
+    dip by more than 4 standard errors of their difference."""
+    d, se = density(draws["n"].to_numpy(), np.arange(0.0, 1.51, 0.1))
+    low, dip, second = 0, 2, 4
+    for peak in (low, second):
+        assert d[peak] - d[dip] > 4 * np.hypot(se[peak], se[dip]), (peak, d.round(2))
+    assert np.argmax(d[3:7]) + 3 in (4, 5), d.round(2)  # the second mode sits at 0.4-0.6
+
+
+def test_m_is_a_spike_at_zero_over_a_flat_plateau(draws):
+    """Most of m's density is in a spike below 0.1; above 0.5 it is flat (no second mode there):
+    every 0.25-wide bin of 0.5-3 lies within 4 standard errors of their mean."""
+    m = draws["m"].to_numpy()
+    d, _ = density(m, np.arange(0.0, 3.01, 0.1))
+    assert d[0] > 5 * np.median(d[5:])
+    plateau, se = density(m, np.arange(0.5, 3.01, 0.25))
+    assert np.all(np.abs(plateau - plateau.mean()) < 4 * se), plateau.round(3)
+
+
+def test_delta3_sits_at_its_lower_bound(draws):
+    assert np.mean(draws["Delta3"] < 0.04) > 0.9  # the lowest fifth of the box, 0-4 GPa
