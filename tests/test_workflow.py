@@ -168,6 +168,16 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
     assert flagged == {"emulator", "calibrate", "predict_design", *histories}, flagged
 
 
+def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_path):
+    """observed.sd_fraction sets the calibrations' likelihood and Figures 9-10's error bars, and
+    nothing else: the declared slices (shockcal.stages) list it there and only there. Until the
+    declaration the two figures did not list it and were left stale by a change."""
+    results, config = study
+    wider = overlay(tmp_path / "sd.yaml", observed={"sd_fraction": 0.02})
+    flagged = params_changed(config, wider) - params_changed(config)
+    assert flagged == {"calibrate", "figure_fig09_features_emulator", "figure_fig10_features_hydrocode"}, flagged
+
+
 def test_coverage_checks_fan_out_in_batches_of_trials(study):
     # quick.yaml: 4 trials per check, 2 per job -> 2 batch jobs per truth, one merge each
     jobs = pending_jobs(study[1], target="check")

@@ -133,7 +133,7 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
     """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
     one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box, seeded from
     `stream` of study.seed (`shockcal.seeds`) unless `seed` is given."""
-    if config["design"]["file"] and not lhs:
+    if not lhs and config["design"]["file"]:
         design = load_design(config["design"]["file"], config)
         return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
     seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed

@@ -25,16 +25,6 @@ def chunk_count(n_runs: int, chunk_size: int) -> int:
     return -(-n_runs // chunk_size)
 
 
-def physics_slice(config: dict, shot: str) -> dict:
-    """What a hydrocode run of `shot` depends on besides its design rows."""
-    from shockcal.config import end_time_us
-
-    spec = config["shots"][shot]
-    geometry = {k: spec[k] for k in ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")}
-    return {"material": config["material"], "hydro": config["hydro"], "shot": geometry,
-            "end_time_us": end_time_us(config, spec)}
-
-
 def check_truth_inputs(truth: str, results: str, shots) -> dict:
     """Inputs of a coverage-check batch besides the emulator: for hydrocode truth the check design
     and its runs' features per shot; for emulator truth none."""

@@ -20,9 +20,7 @@ rule calibrate:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
-        calibration=config["calibration"],
-        sd_fraction=config["observed"]["sd_fraction"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "calibrate"),
         shots=lambda w: " ".join(SHOTS if w.name == "joint" else [w.name]),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
@@ -54,9 +52,7 @@ rule calibration_check_batch:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
-        calibration=config["calibration"],
-        sd_fraction=config["observed"]["sd_fraction"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "calibrate_check"),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
         shots=" ".join(SHOTS),
         trial_range=lambda w: chunk_rows(w.batch, CHECK["trials_per_job"], CHECK["trials"]),

@@ -6,19 +6,21 @@ import yaml
 
 from shockcal.config import shot_inputs
 from shockcal.design import chunk_fingerprints, planned_design
+from shockcal.stages import figure_config, stage_config
 from shockcal.workflow import (
     check_truth_inputs,
     chunk_count,
     chunk_rows,
     export_to_jobs,
-    physics_slice,
     write_if_changed,
 )
 
 # The merged config (configfile + --configfile + --config) that every shockcal call reads, named by
 # its content so a dry run with other settings never rewrites the file running jobs read. Jobs get
 # it through $SHOCKCAL_CONFIG (the default of every `shockcal --config`); it is not a rule input or
-# param: reruns follow each rule's params slice, never this file's name or mtime.
+# param: reruns follow each rule's params slice, never this file's name or mtime. A rule's `settings`
+# param is `stage_config(config, STAGE)`: the keys shockcal.stages declares its stage reads, the same
+# slice the `shockcal` command hands the stage's code, so the two channels cannot drift apart.
 _EFFECTIVE_TEXT = yaml.safe_dump(config, sort_keys=True)
 EFFECTIVE_CONFIG = f"{RESULTS}/config/effective-{hashlib.sha256(_EFFECTIVE_TEXT.encode()).hexdigest()[:12]}.yaml"
 write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)

@@ -11,8 +11,6 @@ rule design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        design=config["design"],
-        inputs=config["inputs"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "design"),
     shell:
         "shockcal design --out {output} > {log} 2>&1"

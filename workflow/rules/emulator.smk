@@ -21,8 +21,7 @@ rule emulator:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]
     params:
-        emulator=config["emulator"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "emulate"),
         pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
         out=lambda w, output: os.path.dirname(output.emulator),
     shell:

@@ -14,8 +14,7 @@ rule features_chunk:
     conda:
         "../envs/shockcal.yaml"
     params:
-        features=config["features"],
-        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
+        settings=lambda w: stage_config(config, "features", w.shot),
     shell:
         "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget --out {output} > {log} 2>&1"
 
@@ -32,7 +31,7 @@ rule features:
     conda:
         "../envs/shockcal.yaml"
     params:
-        max_failed_fraction=config["simulate"]["max_failed_fraction"],
+        settings=lambda w: stage_config(config, "failure_budget", w.shot),
     shell:
         "shockcal features --shot {wildcards.shot} --tables {input} --out {output} > {log} 2>&1"
 
@@ -51,9 +50,7 @@ rule observed:
     conda:
         "../envs/shockcal.yaml"
     params:
-        observed=config["observed"],
-        features=config["features"],
-        analysis={shot: spec.get("analysis", {}) for shot, spec in config["shots"].items()},
+        settings=stage_config(config, "observed"),
     shell:
         "shockcal observed --out {output} > {log} 2>&1"
 

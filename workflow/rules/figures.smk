@@ -79,8 +79,7 @@ for _name, _spec in FIGURE_SPECS.items():
             shot=HISTORY_SHOTS.get(_name, ""),
             out_dir=lambda w, output: os.path.dirname(output[0]),
             inputs=" ".join(f"--input {key}={path}" for key, paths in _files.items() for path in paths),
-            figures=config["figures"],
-            seed=config["study"]["seed"] if _name in HISTORY_SHOTS else None,  # seeds.py: the figures stream
+            settings=figure_config(config, _name),
         shell:
             "shockcal figures --figure {params.figure} --out-dir {params.out_dir}" " {params.inputs} > {log} 2>&1"
 

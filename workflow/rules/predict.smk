@@ -22,8 +22,7 @@ rule predict_design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        predict=config["predict"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "predict"),
     shell:
         "shockcal predict --posterior {input.posterior} --out {output} > {log} 2>&1"
 
@@ -38,11 +37,9 @@ rule check_design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        trials=RUN_SETS["check"],
-        inputs=config["inputs"],
-        seed=config["study"]["seed"],
+        settings=stage_config(config, "check_design"),
     shell:
-        "shockcal design --lhs --n-runs {params.trials} --stream check_design" " --out {output} > {log} 2>&1"
+        "shockcal design --stream check_design --out {output} > {log} 2>&1"
 
 
 rule run_set_simulate:
@@ -59,7 +56,7 @@ rule run_set_simulate:
     conda:
         "../envs/shockcal.yaml"
     params:
-        physics=lambda w: physics_slice(config, w.shot),
+        settings=lambda w: stage_config(config, "simulate", w.shot),
         rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
         end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
     shell:
@@ -83,9 +80,7 @@ rule run_set_features:
     conda:
         "../envs/shockcal.yaml"
     params:
-        features=config["features"],
-        analysis=lambda w: config["shots"][w.shot].get("analysis", {}),
-        max_failed_fraction=config["simulate"]["max_failed_fraction"],
+        settings=lambda w: stage_config(config, ["features", "failure_budget"], w.shot),
     shell:
         "shockcal features --shot {wildcards.shot} --traces {input} --out {output}" " > {log} 2>&1"
 
@@ -105,6 +100,7 @@ rule predict_emulator:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
     params:
+        settings=stage_config(config, "emulate_predict"),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
         "shockcal predict-emulator --design {input.design}"

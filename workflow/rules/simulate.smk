@@ -15,7 +15,7 @@ rule simulate:
     conda:
         "../envs/shockcal.yaml"
     params:
-        physics=lambda w: physics_slice(config, w.shot),
+        settings=lambda w: stage_config(config, "simulate", w.shot),
         rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
         rows_digest=lambda w: CHUNK_DIGESTS[w.shot][int(w.chunk)],
     shell:

@@ -46,11 +46,11 @@ def run(args) -> int:
     import logging
 
     from shockcal.calibration import calibrate
-    from shockcal.config import load_config
     from shockcal.emulator import Emulator
     from shockcal.io import read_table, write_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "calibrate")
     emulator = Emulator.load(args.emulator)
     observed = read_table(args.observed)
     samples, summary, info = calibrate(emulator, args.shots, observed, config, source=args.observed,
@@ -70,11 +70,11 @@ def run(args) -> int:
 
 def run_check(args) -> int:
     from shockcal.calibration import coverage_check
-    from shockcal.config import load_config
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "calibrate_check")
     truths = hydro_truths(args)
     table, coverage = coverage_check(Emulator.load(args.emulator), args.shots, config,
                                      trials=trial_range(args.trial_range) or args.trials, truths=truths)

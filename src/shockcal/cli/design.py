@@ -12,7 +12,8 @@ def register(subparsers) -> None:
     p.add_argument("--n-runs", type=int, default=None, help="override design.n_runs")
     p.add_argument("--seed", type=int, default=None, help="override study.seed")
     p.add_argument("--stream", default="design", choices=["design", "check_design"],
-                   help="the random stream of study.seed the hypercube draws from (shockcal.seeds)")
+                   help="the random stream of study.seed the hypercube draws from (shockcal.seeds); "
+                        "check_design: the synthetic-truth check's runs, calibration.check.trials of them by default")
     p.add_argument("--lhs", action="store_true",
                    help="a Latin hypercube over the box even when the config names a design file")
     p.set_defaults(func=run)
@@ -21,12 +22,17 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import input_names, load_config
+    from shockcal.config import input_names
     from shockcal.design import study_design
     from shockcal.io import write_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
-    design, source = study_design(config, args.n_runs, args.seed, args.stream, args.lhs)
+    config = load_stage_config(args.config, args.stream)  # the design or check_design stage
+    if args.stream == "check_design":  # the check's truth runs: always a hypercube, of check.trials runs
+        n_runs, lhs = args.n_runs or config["calibration"]["check"]["trials"], True
+    else:
+        n_runs, lhs = args.n_runs, args.lhs
+    design, source = study_design(config, n_runs, args.seed, args.stream, lhs)
     units = {name: config["inputs"][name]["unit"] for name in input_names(config)}
     write_table(design[["run", *input_names(config)]], args.out,
                 {"table": "design", "source": source, "units": units})

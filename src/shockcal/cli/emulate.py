@@ -39,12 +39,13 @@ def run(args) -> int:
     import logging
     from pathlib import Path
 
-    from shockcal.config import load_config, shot_config
+    from shockcal.config import shot_config
     from shockcal.design import load_design
     from shockcal.emulator import fit_emulator
     from shockcal.io import read_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "emulate")
     if args.structure:
         config["emulator"]["structure"] = args.structure
     paths = parse_pairs(args.features, "--features")
@@ -102,13 +103,13 @@ def print_cv(args) -> int:
 
 
 def predict(args) -> int:
-    from shockcal.config import load_config
     from shockcal.design import load_design
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
     from shockcal.predict import emulator_predictions_long
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "emulate_predict")
     emulator = Emulator.load(args.emulator)
     design = load_design(args.design, config, columns=emulator.required_inputs(emulator.shots))
     table = emulator_predictions_long(emulator, design, emulator.shots)

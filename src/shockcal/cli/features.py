@@ -35,12 +35,11 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import pandas as pd
 
-    from shockcal.config import load_config, shot_config
     from shockcal.features import check_failures, record_features
     from shockcal.io import read_table, write_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
-    shot_config(config, args.shot)
+    config = load_stage_config(args.config, feature_stages(args), args.shot)
     if args.record:
         table = pd.DataFrame([{"run": 0, "status": "ok", "reason": "",
                                **record_features(config, args.shot, args.record, args.time_column,
@@ -61,12 +60,19 @@ def run(args) -> int:
     return 0
 
 
+def feature_stages(args) -> list[str]:
+    """The stages (shockcal.stages) a `features` call is: extraction, the failed-run budget, or both."""
+    extracts = not args.tables
+    budget = not args.record and not args.no_failure_budget
+    return [stage for stage, used in (("features", extracts), ("failure_budget", budget)) if used]
+
+
 def run_observed(args) -> int:
-    from shockcal.config import load_config
     from shockcal.features import observed_table
     from shockcal.io import write_table
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "observed")
     table = observed_table(config)
     write_table(table, args.out, {"table": "observed features", "units": UNITS})
     log.info("observed features:\n%s", table.drop(columns="source").to_string(index=False))

@@ -35,8 +35,9 @@ def run(args) -> int:
 
     from shockcal.config import load_config
     from shockcal.errors import InputError
-    from shockcal.plots.catalogue import FigureInputs, build_figure, catalogue
+    from shockcal.plots.catalogue import FigureInputs, catalogue, figure_spec
     from shockcal.plots.style import save_figure
+    from shockcal.stages import figure_config
 
     config = load_config(args.config)
     if args.list:
@@ -45,7 +46,9 @@ def run(args) -> int:
         return 0
     if not args.figure:
         raise InputError("give --figure NAME (or --list)")
-    fig = build_figure(args.figure, FigureInputs(parse_inputs(args.input)), config)
+    spec = figure_spec(args.figure, config)
+    config = figure_config(config, args.figure)  # the figure's code sees only the keys it declares
+    fig = spec.build(FigureInputs(parse_inputs(args.input)), config)
     paths = save_figure(fig, Path(args.out_dir) / args.figure, config["figures"]["formats"], config["figures"]["dpi"])
     logging.getLogger("shockcal.figures").info("wrote %s", ", ".join(map(str, paths)))
     return 0

@@ -25,12 +25,12 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import load_config
     from shockcal.io import read_table, write_table
     from shockcal.predict import draw_posterior_design
     from shockcal.seeds import stream_seed
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "predict")
     n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
     seed = stream_seed(config["study"]["seed"], "posterior_draws") if args.seed is None else args.seed
     design = draw_posterior_design(read_table(args.posterior), config, n_runs, seed, source=args.posterior)
@@ -44,13 +44,13 @@ def run(args) -> int:
 def run_emulator(args) -> int:
     import logging
 
-    from shockcal.config import load_config
     from shockcal.design import load_design
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
     from shockcal.predict import emulator_predictions
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
+    config = load_stage_config(args.config, "emulate_predict")
     emulator = Emulator.load(args.emulator)
     shots = [s for s in config["shots"] if s in emulator.shots]
     design = load_design(args.design, config)

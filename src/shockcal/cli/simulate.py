@@ -20,14 +20,14 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import load_config, shot_config, shot_inputs
+    from shockcal.config import shot_inputs
     from shockcal.design import load_design, validate_shot_parameters
     from shockcal.errors import InputError
     from shockcal.io import write_table
     from shockcal.simulate import UNITS, simulate_design
+    from shockcal.stages import load_stage_config
 
-    config = load_config(args.config)
-    shot_config(config, args.shot)
+    config = load_stage_config(args.config, "simulate", args.shot)
     rows = slice(*parse_span(args.rows, "--rows"))
     design = load_design(args.design, config, columns=shot_inputs(config, args.shot)).iloc[rows]
     validate_shot_parameters(design, config, args.shot, args.design)

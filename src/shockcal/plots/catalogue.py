@@ -66,6 +66,7 @@ class FigureSpec:
     name: str
     category: str
     build: Callable  # (FigureInputs, config) -> matplotlib Figure
+    reads: tuple[str, ...] = ()  # config keys `build` reads besides `figures` (shockcal.stages paths)
 
 
 def _shots(config) -> list[str]:
@@ -147,30 +148,44 @@ def history_names(config) -> dict[str, str]:
     return {f"fig{11 + i}_history_{shot}": shot for i, shot in enumerate(_shots(config)[:3])}
 
 
+# what the builders read: the shots (names, analysis windows), the records' columns, the extractor's
+# settings, the prior box, the observation error, the figures' random stream
+_RECORDS = ("shots", "observed.records")
+_TRACE = (*_RECORDS, "features")
+_POSTERIOR = ("shots", "inputs")
+_FEATURE_SPACE = ("shots", "observed.sd_fraction")
+
+
 def catalogue(config) -> dict[str, FigureSpec]:
     """Every figure of the study, in the paper's order (cheap: nothing is imported until a figure is built)."""
     specs = [
         FigureSpec("fig01_toy_calibration", "1 method", partial(_toy, "fig01_toy_calibration")),
-        FigureSpec("fig02_records", "2 data", _records),
+        FigureSpec("fig02_records", "2 data", _records, _RECORDS),
         FigureSpec("fig03_gp_draws", "1 method", partial(_toy, "fig03_gp_draws")),
-        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features")),
-        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split")),
-        FigureSpec("fig06_crossval", "3 emulator", _crossval),
-        FigureSpec("fig07_marginals", "4 posterior", _marginals),
-        FigureSpec("fig08_pairs", "4 posterior", _pairs),
-        FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator),
-        FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode),
-        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot))
+        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features"), _TRACE),
+        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split"), _TRACE),
+        FigureSpec("fig06_crossval", "3 emulator", _crossval, ("shots",)),
+        FigureSpec("fig07_marginals", "4 posterior", _marginals, _POSTERIOR),
+        FigureSpec("fig08_pairs", "4 posterior", _pairs, _POSTERIOR),
+        FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator, _FEATURE_SPACE),
+        FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode, _FEATURE_SPACE),
+        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot), (*_RECORDS, "study.seed"))
           for name, shot in history_names(config).items()),
         FigureSpec("fig14_inadequate_model", "1 method", partial(_toy, "fig14_inadequate_model")),
-        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction")),
+        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), _TRACE),
     ]
     return {spec.name: spec for spec in specs}
 
 
-def build_figure(name: str, inputs: FigureInputs, config: dict):
-    """Draw figure `name`; an unknown name is an InputError listing the known ones."""
+def figure_spec(name: str, config: dict) -> FigureSpec:
+    """The catalogue entry of figure `name`; an unknown name is an InputError listing the known ones."""
     specs = catalogue(config)
     if name not in specs:
         raise InputError(f"unknown figure '{name}'; known figures: {', '.join(specs)}")
-    return specs[name].build(inputs, config)
+    return specs[name]
+
+
+def build_figure(name: str, inputs: FigureInputs, config: dict):
+    """Draw figure `name` (config: at least the keys its spec `reads`); an unknown name is an
+    InputError listing the known ones."""
+    return figure_spec(name, config).build(inputs, config)

@@ -1,0 +1,124 @@
+"""The config keys each stage reads, declared once.
+
+`STAGE_KEYS[stage]` lists dotted key paths of the validated study config. The same declaration
+serves both channels a stage gets its settings through:
+
+- the workflow's rules put `stage_config(config, stage, shot)` in their `params:`, so a change of
+  any key the stage reads, and of no other, reruns it;
+- `shockcal` commands call `load_stage_config`, which validates the whole config and hands the
+  stage's library code only that slice, so code that reads an undeclared key fails at once (in
+  the tests) instead of silently missing from the rerun triggers.
+
+Path segments: a key; `*` every key at that level (e.g. every shot); `{shot}` the shot the job
+works on; `{shot_inputs}` the design columns that shot reads (`config.shot_inputs`).
+"""
+from __future__ import annotations
+
+import copy
+from collections.abc import Iterable, Iterator
+
+from shockcal.config import load_config, shot_config, shot_inputs
+
+_SHOT_GEOMETRY = ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")
+_SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
+
+STAGE_KEYS: dict[str, tuple[str, ...]] = {
+    # the training design: a Latin hypercube of the box, or the design file checked against it
+    "design": ("study.seed", "design", "inputs", "checks.design_box", "shots.*.velocity_input"),
+    # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
+    "check_design": ("study.seed", "inputs", "calibration.check.trials"),
+    # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto
+    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}",
+                 *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
+                 "shots.{shot}.analysis.window_after_arrival_us"),
+    # features of one shot's traces (one chunk, or a whole run set with the failure budget)
+    "features": ("features", "shots.{shot}.analysis"),
+    # the failed-run budget where a shot's features are merged
+    "failure_budget": ("simulate.max_failed_fraction", "shots.{shot}.analysis"),
+    # the measured features of every shot (from the records or the published values)
+    "observed": ("observed.source", "observed.features", "observed.records", "features", "shots.*.analysis",
+                 "checks.observed_units"),
+    # the emulator fit and its cross-validation
+    "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", *_SHOT_MAPPING),
+    # the emulator's predictions at a design's runs
+    "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
+    # one calibration (single shot or joint)
+    "calibrate": ("study.seed", "calibration.n_live", "calibration.n_eff", "calibration.draws",
+                  "observed.sd_fraction", "checks.observed_units", "inputs"),
+    # a batch of synthetic-truth trials
+    "calibrate_check": ("study.seed", "calibration.check", "observed.sd_fraction", "checks.observed_units",
+                        "inputs"),
+    # the posterior rows run through the hydrocode for predictions
+    "predict": ("study.seed", "predict.n_posterior_runs", "inputs"),
+    # every figure; each adds the keys its catalogue entry `reads` (figure_config)
+    "figures": ("figures",),
+}
+
+
+def stage_config(config: dict, stages: str | Iterable[str], shot: str | None = None) -> dict:
+    """The slice of a validated `config` that `stages` read (a nested dict of the same shape),
+    for `shot` where a path names `{shot}`."""
+    stages = [stages] if isinstance(stages, str) else list(stages)
+    unknown = [stage for stage in stages if stage not in STAGE_KEYS]
+    if unknown:
+        raise ValueError(f"unknown stage {unknown[0]!r}; stages: {', '.join(STAGE_KEYS)}")
+    return config_slice(config, [path for stage in stages for path in STAGE_KEYS[stage]], shot, "+".join(stages))
+
+
+def figure_config(config: dict, name: str) -> dict:
+    """The slice figure `name` reads: the figures stage's keys and its catalogue entry's `reads`."""
+    from shockcal.plots.catalogue import figure_spec
+
+    return config_slice(config, [*STAGE_KEYS["figures"], *figure_spec(name, config).reads], label=name)
+
+
+def config_slice(config: dict, paths: Iterable[str], shot: str | None = None, label: str = "") -> dict:
+    """The keys `paths` (this module's path syntax) of `config`, as a nested dict of the same shape;
+    `label` names the declaration in errors."""
+    sliced: dict = {}
+    for path in paths:
+        for keys in _expand(config, path.split("."), shot, label):
+            _copy(config, keys, sliced, f"{label}: {path}")
+    return sliced
+
+
+def load_stage_config(path, stages: str | Iterable[str], shot: str | None = None) -> dict:
+    """Read and validate the whole study config at `path` (every key is checked), then return the
+    slice `stages` read; with `shot`, an unknown shot is a ConfigError naming the known ones."""
+    config = load_config(path)
+    if shot is not None:
+        shot_config(config, shot)
+    return stage_config(config, stages, shot)
+
+
+def _expand(config: dict, parts: list[str], shot: str | None, stage: str) -> Iterator[list[str]]:
+    """Every concrete key path of one declared path."""
+    for i, part in enumerate(parts):
+        if part in ("{shot}", "{shot_inputs}") and shot is None:
+            raise ValueError(f"stage {stage}: {'.'.join(parts)} needs a shot")
+        if part == "{shot}":
+            parts = [*parts[:i], shot, *parts[i + 1:]]
+        elif part in ("*", "{shot_inputs}"):
+            node = _node(config, parts[:i], f"{stage}: {'.'.join(parts)}")
+            keys = node if part == "*" else shot_inputs(config, shot)
+            for key in keys:
+                yield from _expand(config, [*parts[:i], key, *parts[i + 1:]], shot, stage)
+            return
+    yield parts
+
+
+def _node(config: dict, keys: list[str], declared: str):
+    node = config
+    for key in keys:
+        if not isinstance(node, dict) or key not in node:
+            raise KeyError(f"config key {'.'.join(keys)} (declared by stage {declared}) is not in the config")
+        node = node[key]
+    return node
+
+
+def _copy(config: dict, keys: list[str], sliced: dict, declared: str) -> None:
+    value = _node(config, keys, declared)
+    target = sliced
+    for key in keys[:-1]:
+        target = target.setdefault(key, {})
+    target[keys[-1]] = copy.deepcopy(value)  # a stage may change its slice (an option's override)

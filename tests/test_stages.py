@@ -1,0 +1,63 @@
+"""shockcal.stages: one declaration of the config keys each stage reads, serving both the rules'
+params and the slice each command hands its library code (issue 15)."""
+from pathlib import Path
+
+import pytest
+
+from shockcal.config import load_config
+from shockcal.plots.catalogue import catalogue
+from shockcal.stages import STAGE_KEYS, config_slice, figure_config, stage_config
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def config():
+    return load_config(REPO / "config" / "config.yaml")
+
+
+def needs_shot(stage: str) -> bool:
+    return any("{shot" in path for path in STAGE_KEYS[stage])
+
+
+def test_every_declared_key_exists_in_the_default_study(config):
+    for stage in STAGE_KEYS:
+        for shot in config["shots"] if needs_shot(stage) else [None]:
+            assert stage_config(config, stage, shot), stage
+    for name in catalogue(config):
+        assert "figures" in figure_config(config, name)
+
+
+def test_a_shot_stage_sees_its_own_shot_and_inputs_only(config):
+    sliced = stage_config(config, "simulate", "105S")
+    assert list(sliced["shots"]) == ["105S"]
+    assert set(sliced["inputs"]) == {"A", "B", "C", "n", "m", "V2", "G1", "Delta2"}
+    assert "analysis" in sliced["shots"]["105S"] and set(sliced["shots"]["105S"]["analysis"]) == {
+        "window_after_arrival_us"}
+    assert not {"emulator", "calibration", "observed", "features", "study"} & set(sliced)
+
+
+def test_a_sampler_setting_is_outside_every_stage_but_the_calibration(config):
+    readers = {stage for stage in STAGE_KEYS
+               if "n_live" in stage_config(config, stage, "104S" if needs_shot(stage) else None).get("calibration", {})}
+    assert readers == {"calibrate"}
+
+
+def test_the_slice_is_a_copy(config):
+    sliced = stage_config(config, "emulate")
+    sliced["emulator"]["structure"] = "per_shot"
+    assert config["emulator"]["structure"] == "joint"
+
+
+def test_only_history_figures_read_the_seed(config):
+    seeded = {name for name in catalogue(config) if "study" in figure_config(config, name)}
+    assert seeded == {"fig11_history_104S", "fig12_history_105S", "fig13_history_106S"}
+
+
+def test_an_undeclared_or_misspelt_key_is_named(config):
+    with pytest.raises(KeyError, match="calibration.n_lives"):
+        config_slice(config, ["calibration.n_lives"], label="test")
+    with pytest.raises(ValueError, match="needs a shot"):
+        stage_config(config, "simulate")
+    with pytest.raises(ValueError, match="unknown stage 'simulation'"):
+        stage_config(config, "simulation")
