@@ -65,11 +65,21 @@ def reference(problem, name: str, directory: Path, n_live: int, n_eff: int) -> p
 
 def quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> float:
     """Worst |quantile - reference quantile| / box width over parameters and QUANTILES."""
-    worst = 0.0
+    return worst_quantile_error(points, ref, names, width)[0]
+
+
+def worst_quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> tuple[float, str]:
+    """Worst |quantile - reference quantile| / box width over parameters and QUANTILES, and where."""
+    worst, where = 0.0, ""
     for j, name in enumerate(names):
         q_ref = weighted_quantiles(ref[name].to_numpy(), ref["weight"].to_numpy(), QUANTILES)
-        worst = max(worst, float(np.max(np.abs(np.quantile(points[:, j], QUANTILES) - q_ref)) / width[j]))
-    return worst
+        q = np.quantile(points[:, j], QUANTILES)
+        error = np.abs(q - q_ref) / width[j]
+        if error.max() > worst:
+            k = int(np.argmax(error))
+            worst, where = float(error.max()), (f"{name} q{round(100 * QUANTILES[k]):02d} "
+                                                f"{q[k]:.4g} against {q_ref[k]:.4g}")
+    return worst, where
 
 
 def quantile_z(draws, ref: pd.DataFrame, names) -> tuple[float, str]:
@@ -122,12 +132,14 @@ def run_smc(problem, particles: int, moves: int, seed: int):
     return points, time.perf_counter() - start, time.process_time() - cpu, evaluations[0]
 
 
-def run_dynesty(problem, n_live: int, seed: int):
+def run_dynesty(problem, n_live: int, seed: int, keep: Path):
     """dynesty's static nested sampling (multi-ellipsoid bounds, random slices; one point per call):
     the independent cross-check of the reference. Equal-weight draws, wall and CPU seconds, calls,
-    and its log evidence with its error."""
+    the weighted draws (also written to `keep`, about an hour's work) and its log evidence with its error."""
     import dynesty
     from dynesty.utils import resample_equal
+
+    from shockcal.sampler import WeightedDraws
 
     rng = np.random.default_rng(seed)
     start, cpu = time.perf_counter(), time.process_time()
@@ -136,9 +148,14 @@ def run_dynesty(problem, n_live: int, seed: int):
                                     bound="multi", sample="rslice", rstate=rng)
     sampler.run_nested(dlogz=0.1, print_progress=False)
     result = sampler.results
-    weights = np.exp(result.logwt - result.logz[-1])
-    points = resample_equal(result.samples, weights / weights.sum(), rstate=rng)
-    return (points, time.perf_counter() - start, time.process_time() - cpu, int(np.sum(result.ncall)),
+    log_weight = result.logwt - result.logz[-1]
+    weights = np.exp(log_weight) / np.exp(log_weight).sum()
+    points = resample_equal(result.samples, weights, rstate=rng)
+    keep.parent.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(result.samples, columns=[*problem.names, "lambda_y"]).assign(weight=weights).to_parquet(keep)
+    draws = WeightedDraws(result.samples, np.log(weights), result.logl, float(result.logz[-1]),
+                          int(np.sum(result.ncall)))
+    return (points, time.perf_counter() - start, time.process_time() - cpu, int(np.sum(result.ncall)), draws,
             float(result.logz[-1]), float(result.logzerr[-1]))
 
 
@@ -157,7 +174,8 @@ def report(label, runs, ref, names, width):
         print(f"  {label} ESS of the mean per parameter (replicate spread): "
               + ", ".join(f"{n} {e:.0f}" for n, e in zip(names, ess)) + f"; min {ess.min():.0f}")
     print(f"  {label} worst quantile error vs reference: median {np.median(errors):.4f}, max {np.max(errors):.4f} "
-          f"of the box; mass at A > 800 MPa {np.mean(tip):.3f} (reference "
+          f"of the box ({worst_quantile_error(runs[int(np.argmax(errors))][0], ref, names, width)[1]}); "
+          f"mass at A > 800 MPa {np.mean(tip):.3f} (reference "
           f"{ref['weight'][ref['A'] > TIP_A_MBAR].sum() if 'A' in names else np.nan:.3f})")
     for draws in weighted:
         z, where = quantile_z(draws, ref, names)
@@ -230,7 +248,8 @@ def main(argv=None) -> int:
             report("default", [run_default(problem, settings, seed) for seed in range(1, args.replicates + 1)],
                    ref, names, width)
         if args.dynesty:
-            *run, log_z, log_z_error = run_dynesty(problem, args.dynesty, seed=1)
+            *run, log_z, log_z_error = run_dynesty(problem, args.dynesty, seed=1,
+                                                   keep=Path(args.reference_dir) / f"dynesty_{name}.parquet")
             report(f"dynesty ({args.dynesty} live, slices)", [run], ref, names, width)
             print(f"  dynesty log evidence {log_z:.3f} +- {log_z_error:.3f}")
         if args.smc:

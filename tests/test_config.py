@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
+import yaml
 
 from shockcal.config import load_config, shot_config, validate_config
 from shockcal.errors import ConfigError
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _set(config: dict, path: str, value) -> None:
@@ -83,3 +90,23 @@ def test_unreadable_files(tmp_path):
     broken.write_text("shots: [unclosed\n")
     with pytest.raises(ConfigError, match=f"{broken} is not valid YAML"):
         load_config(broken)
+
+
+def test_the_library_validates_a_config_without_snakemake():
+    """A notebook user needs neither snakemake installed nor imported: the schema check is jsonschema's."""
+    code = ("import sys; from shockcal.config import load_config; import shockcal.cli, shockcal.simulate; "
+            "load_config('config/config.yaml'); print(sorted(m for m in sys.modules if m.startswith('snakemake')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=REPO)
+    assert out.stdout.strip() == "[]"
+
+
+def test_hydro_settings_defaults_are_the_schemas():
+    """`HydroSettings()` (the notebook default) and a config that leaves the numerics out agree."""
+    from dataclasses import asdict
+
+    from shockcal.config import SCHEMA_PATH
+    from shockcal.hydro import HydroSettings
+
+    schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]["hydro"]["properties"]
+    defaults = {k: v["default"] for k, v in schema.items() if "default" in v}
+    assert {k: v for k, v in asdict(HydroSettings()).items() if k != "cell_size_um"} == defaults

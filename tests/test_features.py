@@ -151,10 +151,11 @@ def test_neighbouring_hydrocode_runs_have_neighbouring_features(paper_config):
     runs): two runs 1e-4 apart in C give slope velocities within 0.5 m/s."""
     from shockcal.design import ShotParameters
     from shockcal.hydro import run_shot
+    from shockcal.simulate import hydro_inputs
 
     paper_config["hydro"]["end_time_us"] = 2.1
     shot = paper_config["shots"]["106S"]
-    runs = [run_shot(ShotParameters(0.0035, 0.004, C, 0.3, 1.0, 0.0484, 0.33), shot, paper_config)
+    runs = [run_shot(ShotParameters(0.0035, 0.004, C, 0.3, 1.0, 0.0484, 0.33), *hydro_inputs(paper_config, shot))
             for C in (0.0010, 0.0011)]
     first, second = (extract_features(r.t_us, r.v_m_s, shot["analysis"], paper_config["features"]) for r in runs)
     for column in ("v_elastic", "v_slope1", "v_slope2", "v_plastic"):

@@ -19,6 +19,7 @@ from shockcal.hydro.strength import (
     thermal_factor,
     thermal_factor_below,
 )
+from shockcal.simulate import hydro_inputs
 
 DATA = Path(__file__).parent / "data"
 
@@ -55,7 +56,7 @@ def test_no_strength_plateau_and_shock_speed(paper_config, velocity):
     arrivals = []
     for target_mm in (1.0, 2.0):
         shot = _setup(paper_config, 3.0, target_mm, 0.9)
-        result = run_shot(params, shot, paper_config)
+        result = run_shot(params, *hydro_inputs(paper_config, shot))
         assert result.status == "ok", result.reason
         t, v = result.t_us, result.v_m_s
         arrivals.append(_arrival(t, v, 0.5 * velocity * 1e4))
@@ -102,7 +103,7 @@ def _precursor(config, cell_size_um, target_mm, Y=0.003, C=0.0):
     _, c_long = _elastic_reference(config, Y)
     t_elastic = target_mm * 0.1 / c_long
     shot = _setup(config, 2.0, target_mm, t_elastic + 0.05, cell_size_um)
-    result = run_shot(ShotParameters(Y, 0.0, C, 0.0, 1.0, 0.0204, G), shot, config)
+    result = run_shot(ShotParameters(Y, 0.0, C, 0.0, 1.0, 0.0204, G), *hydro_inputs(config, shot))
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s
     amplitude = np.median(v[(t > t_elastic + 0.02) & (t < t_elastic + 0.045)])
@@ -135,15 +136,15 @@ def test_mesh_convergence(paper_config):
 
 def test_energy_conserved(paper_config):
     shot = _setup(paper_config, 1.0, 1.5, 0.5)
-    result = run_shot(ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, G), shot, paper_config)
+    result = run_shot(ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, G), *hydro_inputs(paper_config, shot))
     assert result.status == "ok", result.reason
     assert result.energy_error < 1e-3
 
 
 def test_numerical_failure_is_reported(paper_config):
     paper_config["hydro"]["cfl"] = 3.0                 # unstable on purpose
-    result = run_shot(ShotParameters(0.001, 0.0, 0.0, 0.0, 1.0, 0.0204, G), _setup(paper_config, 0.5, 0.5, 0.2),
-                      paper_config)
+    shot = _setup(paper_config, 0.5, 0.5, 0.2)
+    result = run_shot(ShotParameters(0.001, 0.0, 0.0, 0.0, 1.0, 0.0204, G), *hydro_inputs(paper_config, shot))
     assert result.status == "failed"
     assert "cell" in result.reason and "t =" in result.reason
 
@@ -205,7 +206,7 @@ def test_c0_traces_identical_to_the_lagged_rate_code(paper_config):
              "hard_c0_106": ShotParameters(0.004, 0.002, 0.0, 0.2, 0.8, 0.04838, 0.33)}
     shot = _setup(paper_config, 1.0, 1.5, 0.6)
     for name, params in cases.items():
-        result = run_shot(params, shot, paper_config)
+        result = run_shot(params, *hydro_inputs(paper_config, shot))
         assert np.array_equal(result.v_m_s, stored[name]), name
 
 
@@ -221,7 +222,7 @@ def test_flow_stress_floors_change_no_trace(paper_config):
              "strong_104": ShotParameters(0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
     shot = _setup(paper_config, 1.0, 1.5, 0.6)
     for name, params in cases.items():
-        assert np.array_equal(run_shot(params, shot, paper_config).v_m_s, stored[name]), name
+        assert np.array_equal(run_shot(params, *hydro_inputs(paper_config, shot)).v_m_s, stored[name]), name
 
 
 def test_thermal_factor_bound_lies_below_the_factor():

@@ -5,9 +5,9 @@ import pandas as pd
 import pytest
 import yaml
 
+from shockcal import hydro
 from shockcal.cli import main
 from shockcal.design import latin_hypercube
-from shockcal.hydro import solver
 from shockcal.simulate import simulate_design
 
 
@@ -34,12 +34,12 @@ def test_table_has_documented_columns(coarse_config):
 
 def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypatch):
     config, _ = coarse_config
-    real = solver.run_shot
+    real = hydro.run_shot
 
-    def flaky(params, shot, cfg, end_us=None):
+    def flaky(params, *inputs):
         if params.A == design["A"].iloc[1]:
             raise FloatingPointError("synthetic failure")
-        return real(params, shot, cfg, end_us)
+        return real(params, *inputs)
 
     design = latin_hypercube(config, 3, seed=2)
     monkeypatch.setattr("shockcal.simulate.run_shot", flaky)

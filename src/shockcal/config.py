@@ -41,16 +41,34 @@ def load_config(path: str | Path) -> dict:
 def validate_config(config: dict, source: str = "config") -> dict:
     """Validate a config mapping in place (schema + semantics) and return it."""
     from jsonschema.exceptions import ValidationError
-    from snakemake.exceptions import WorkflowError
-    from snakemake.utils import validate
 
     _normalise_shot_names(config)
     try:
-        validate(config, schema=str(SCHEMA_PATH), set_default=True)
-    except (WorkflowError, ValidationError) as exc:
+        _schema_validator().validate(config)
+    except ValidationError as exc:
         raise ConfigError(f"{source}: {_schema_message(exc)}") from None
     check_semantics(config, source)
     return config
+
+
+def _schema_validator():
+    """A JSON Schema (2020-12) validator of config.schema.yaml that also fills each missing key's
+    `default:` before checking it, as jsonschema's FAQ describes (and snakemake's `validate` does)."""
+    import copy
+
+    from jsonschema import Draft202012Validator, validators
+
+    check_properties = Draft202012Validator.VALIDATORS["properties"]
+
+    def fill_defaults(validator, properties, instance, schema):
+        if isinstance(instance, dict):
+            for name, subschema in properties.items():
+                if "default" in subschema and name not in instance:
+                    instance[name] = copy.deepcopy(subschema["default"])
+        yield from check_properties(validator, properties, instance, schema)
+
+    schema = yaml.safe_load(SCHEMA_PATH.read_text())
+    return validators.extend(Draft202012Validator, {"properties": fill_defaults})(schema)
 
 
 def validate_or_exit(config: dict, source: str = "config") -> dict:
@@ -71,15 +89,10 @@ def _normalise_shot_names(config: dict) -> None:
                 section[str(key)] = section.pop(key)
 
 
-def _schema_message(exc: Exception) -> str:
-    """Turn a jsonschema error (snakemake wraps it; the original is its context) into 'key.path: reason'."""
-    from jsonschema.exceptions import ValidationError
-
-    err = exc if isinstance(exc, ValidationError) else exc.__context__
-    if not isinstance(err, ValidationError):
-        return str(exc).strip()
-    key = ".".join(str(p) for p in err.absolute_path) or "<top level>"
-    return f"{key}: {err.message}"
+def _schema_message(exc) -> str:
+    """Turn a jsonschema error into 'key.path: reason'."""
+    key = ".".join(str(p) for p in exc.absolute_path) or "<top level>"
+    return f"{key}: {exc.message}"
 
 
 def check_semantics(config: dict, source: str = "config") -> None:

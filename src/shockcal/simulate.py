@@ -14,9 +14,9 @@ import logging
 import numpy as np
 import pandas as pd
 
-from shockcal.config import shot_config, shot_inputs
+from shockcal.config import end_time_us, shot_config, shot_inputs
 from shockcal.design import shot_parameters
-from shockcal.hydro import run_shot
+from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.simulate")
@@ -27,10 +27,18 @@ UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_r
          "t_us": "us", "v_m_s": "m/s"}
 
 
+def hydro_inputs(config: dict, spec: dict, end_us: float | None = None):
+    """The adapter from a validated config to `run_shot`'s inputs for one shot (`spec`, its `shots`
+    section): (Geometry, MaterialProperties, HydroSettings); `end_us` defaults to the config's end time."""
+    end_us = end_time_us(config, spec) if end_us is None else end_us
+    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us)),
+            MaterialProperties.from_config(config["material"]), HydroSettings.from_config(config["hydro"]))
+
+
 def simulate_design(design: pd.DataFrame, config: dict, shot: str, end_us: float | None = None) -> pd.DataFrame:
     """Simulate every row of `design` for `shot` to `end_us` (default: the config's end time for the
     shot, `hydro.end_time_us`); failures become rows with a reason."""
-    spec = shot_config(config, shot)
+    geometry, material, settings = hydro_inputs(config, shot_config(config, shot), end_us)
     inputs = shot_inputs(config, shot)
     rows = []
     for record in design.to_dict("records"):
@@ -39,7 +47,7 @@ def simulate_design(design: pd.DataFrame, config: dict, shot: str, end_us: float
                "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
                "shear_modulus_GPa": params.shear_modulus_Mbar * MBAR_TO_GPA}
         try:
-            result = run_shot(params, spec, config, end_us)
+            result = run_shot(params, geometry, material, settings)
         except Exception as exc:  # a run must never kill the batch; the reason is kept
             log.exception("run %s of shot %s raised", row["run"], shot)
             rows.append({**row, "status": "failed", "reason": f"{type(exc).__name__}: {exc}",

@@ -25,14 +25,11 @@ when the stress of the cell beyond it becomes non-zero.
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from shockcal.config import end_time_us
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
 from shockcal.hydro.strength import (
     equivalent_strain_rate,
@@ -43,7 +40,6 @@ from shockcal.hydro.strength import (
     thermal_factor,
     thermal_factor_below,
 )
-from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 STATUS_OK, STATUS_NEGATIVE_VOLUME, STATUS_NAN, STATUS_DT_COLLAPSE = 0, 1, 2, 3
 FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "NaN in cell state",
@@ -360,63 +356,3 @@ def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
         if dt < DT_FLOOR_US:
             return v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2]
     return v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2]
-
-
-@dataclass
-class RunResult:
-    """One hydrocode run: free-surface velocity history and diagnostics (user units)."""
-
-    t_us: np.ndarray
-    v_m_s: np.ndarray
-    status: str                      # "ok" or "failed"
-    reason: str = ""
-    max_strain_rate_per_us: float = float("nan")
-    max_temperature_K: float = float("nan")
-    max_plastic_strain: float = float("nan")
-    energy_error: float = float("nan")
-    n_steps: int = 0
-    wall_time_s: float = 0.0
-    energy_history: np.ndarray = field(default=None, repr=False)
-
-
-def material_of(config: dict) -> Material:
-    """The study config's `material` section in code units."""
-    material, eos = config["material"], config["material"]["eos"]
-    return Material(float(material["rho0_g_cc"]), float(eos["c1_Mbar"]), float(eos["c2_Mbar"]), float(eos["c3_Mbar"]),
-                    float(eos["gamma0"]), float(material["T_ref_K"]), float(material["T_melt_K"]),
-                    float(material["cv_J_per_kg_K"]) * J_PER_KG_TO_CODE)
-
-
-def numerics_of(config: dict) -> Numerics:
-    """The study config's `hydro` section's viscosity and time-step settings (us)."""
-    hydro = config["hydro"]
-    return Numerics(float(hydro["q_linear"]), float(hydro["q_quadratic"]), float(hydro["cfl"]),
-                    float(hydro["dt_initial_us"]), float(hydro["dt_max_us"]))
-
-
-def run_shot(params, shot: dict, config: dict, end_us: float | None = None) -> RunResult:
-    """Simulate one shot to `end_us` (default: `end_time_us(config, shot)`). `params` is a
-    shockcal.design.ShotParameters (Mbar, cm/us)."""
-    hydro = config["hydro"]
-    dx = hydro["cell_size_um"] * UM_TO_CM
-    nf = max(int(round(shot["flyer_mm"] * MM_TO_CM / dx)), 1)
-    nt = max(int(round(shot["target_mm"] * MM_TO_CM / dx)), 1)
-    dt_out = hydro["output_dt_ns"] * NS_TO_US
-    end_us = end_time_us(config, shot) if end_us is None else end_us
-    t_out = np.arange(int(round(end_us / dt_out)) + 1) * dt_out
-    strength = Strength(float(params.shear_modulus_Mbar), float(params.A), float(params.B), float(params.C),
-                        float(params.n), float(params.m),
-                        float(config["material"]["strain_rate_ref_per_s"]) * PER_S_TO_PER_US)
-    start = time.perf_counter()
-    v, energy, status, cell, t_fail, steps, max_rate, max_T, max_eps = simulate(
-        nf, nt, dx, float(params.velocity_cm_us), strength, material_of(config), numerics_of(config), t_out)
-    wall = time.perf_counter() - start
-    reason = ""
-    if status != STATUS_OK:
-        where = f" in cell {cell}" if cell >= 0 else ""
-        body = "" if cell < 0 else (" (flyer)" if cell < nf else " (target)")
-        reason = f"{FAILURE_REASONS[status]}{where}{body} at t = {t_fail:.5f} us after {steps} steps"
-    reached = energy[: max(1, np.count_nonzero(energy) or 1)]
-    energy_error = float(np.max(np.abs(reached - energy[0])) / energy[0])
-    return RunResult(t_out, v * CM_US_TO_M_S, "ok" if status == STATUS_OK else "failed", reason,
-                     max_rate, max_T, max_eps, energy_error, int(steps), wall, energy)

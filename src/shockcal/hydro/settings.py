@@ -1,0 +1,85 @@
+"""The hydrocode's inputs in user units: the shot's geometry, the material, the numerics.
+
+These are what `run_shot` takes; each converts itself to the kernel's named tuples in code units
+(cm, us, g/cc, Mbar). Field names are the study config's keys (`material`, `hydro`), so
+`shockcal.simulate.hydro_inputs` builds them from a validated config by name alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from shockcal.hydro.solver import Material, Numerics
+from shockcal.units import J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A symmetric plate impact: flyer and target thickness (mm) and the simulated time (us)."""
+
+    flyer_mm: float
+    target_mm: float
+    end_us: float
+
+
+@dataclass(frozen=True)
+class MaterialProperties:
+    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and
+    target; `strain_rate_ref_per_s` is the Johnson-Cook reference rate eps0."""
+
+    rho0_g_cc: float
+    c1_Mbar: float
+    c2_Mbar: float
+    c3_Mbar: float
+    gamma0: float
+    T_ref_K: float
+    T_melt_K: float
+    cv_J_per_kg_K: float
+    strain_rate_ref_per_s: float = 1.0
+
+    @classmethod
+    def from_config(cls, material: dict) -> MaterialProperties:
+        """From a validated config's `material` section (its `eos` sub-section flattened)."""
+        flat = {**{k: v for k, v in material.items() if k != "eos"}, **material["eos"]}
+        return cls(**{f.name: float(flat[f.name]) for f in fields(cls)})
+
+    def code_units(self) -> Material:
+        return Material(self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0, self.T_ref_K,
+                        self.T_melt_K, self.cv_J_per_kg_K * J_PER_KG_TO_CODE)
+
+    def rate_ref_per_us(self) -> float:
+        return self.strain_rate_ref_per_s * PER_S_TO_PER_US
+
+
+# Al-5083-H131, the paper's Table II (Walters et al. 2018); T_melt from SPEC section 2 (not in the paper).
+AL5083 = MaterialProperties(rho0_g_cc=2.668, c1_Mbar=0.7797, c2_Mbar=0.2239, c3_Mbar=1.668, gamma0=2.13,
+                            T_ref_K=298.0, T_melt_K=893.0, cv_J_per_kg_K=900.0)
+
+
+@dataclass(frozen=True)
+class HydroSettings:
+    """Mesh, output sampling, artificial viscosity (q = rho (q_quadratic du^2 + q_linear c du)) and
+    time stepping; the defaults are the study config's (docs/hydro.md measures them)."""
+
+    cell_size_um: float = 4.0
+    output_dt_ns: float = 0.5
+    cfl: float = 0.5
+    dt_initial_us: float = 1.0e-7
+    dt_max_us: float = 2.0e-3
+    q_linear: float = 0.1
+    q_quadratic: float = 1.0
+
+    @classmethod
+    def from_config(cls, hydro: dict) -> HydroSettings:
+        """From a validated config's `hydro` section (its `end_time_us` belongs to the geometry)."""
+        return cls(**{f.name: float(hydro[f.name]) for f in fields(cls)})
+
+    def numerics(self) -> Numerics:
+        return Numerics(self.q_linear, self.q_quadratic, self.cfl, self.dt_initial_us, self.dt_max_us)
+
+    def cells(self, thickness_mm: float) -> int:
+        """Cells across a plate (at least one)."""
+        return max(int(round(thickness_mm * MM_TO_CM / (self.cell_size_um * UM_TO_CM))), 1)
+
+    def output_dt_us(self) -> float:
+        return self.output_dt_ns * NS_TO_US
