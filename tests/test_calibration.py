@@ -8,6 +8,7 @@ from scipy import stats
 from shockcal.calibration import (
     LAMBDA_Y_PRIOR,
     SUMMARY_QUANTILES,
+    CalibrationSettings,
     Problem,
     SamplerSettings,
     calibrate,
@@ -119,8 +120,9 @@ def test_calibrate_returns_draws_summary_and_evidence(paper_config):
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2, 80 + 20 * t[:, 0] ** 2]),
                                ["A"], [-1], [1], 0.01 * np.eye(2))
     paper_config["inputs"]["A"] = {"min": -1, "max": 1, "unit": "Mbar"}
-    samples, summary, info = calibrate(emulator, ["S"], _observed([118.0, 87.2]), paper_config, n_live=200,
-                                       n_eff=800, draws=1000)
+    paper_config["calibration"].update(n_live=200, n_eff=800, draws=1000)
+    settings = CalibrationSettings.from_config(paper_config, ["S"])
+    samples, summary, info = calibrate(emulator, ["S"], _observed([118.0, 87.2]), settings)
     assert len(samples) == 1000 and set(samples.columns) == {"A", "lambda_y", "log_likelihood"}
     assert list(summary["parameter"]) == ["A", "lambda_y"] and list(summary["unit"]) == ["Mbar", "-"]
     row = summary.set_index("parameter").loc["A"]

@@ -5,12 +5,20 @@ from __future__ import annotations
 import copy
 import json
 import re
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.calibration import HydroTruths, Problem, calibrate, coverage_table, synthetic_truth
+from shockcal.calibration import (
+    CalibrationSettings,
+    HydroTruths,
+    Problem,
+    calibrate,
+    coverage_table,
+    synthetic_truth,
+)
 from shockcal.errors import InputError
 
 FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -65,6 +73,14 @@ def mid_box(emulator, shots) -> dict:
     return dict(zip(names, np.mean(emulator.input_bounds(names), axis=0)))
 
 
+def _settings(config, n_live=None, n_eff=None):
+    """The config's calibration settings, the sampler's live points and ESS replaced when given."""
+    settings = CalibrationSettings.from_config(config, ["toy"])
+    sampler = replace(settings.sampler, n_live=n_live or settings.sampler.n_live,
+                      n_eff=n_eff or settings.sampler.n_eff)
+    return replace(settings, sampler=sampler)
+
+
 @pytest.fixture
 def small_config(paper_config):
     paper_config["calibration"].update(n_live=200, n_eff=500, draws=2000)
@@ -77,7 +93,7 @@ def three_toy_trials(paper_config_readonly):
     config = copy.deepcopy(paper_config_readonly)
     config["calibration"].update(n_live=200, n_eff=500, draws=2000)
     emu = ShotEmulator(config, shots=["toy"], emulator_sd=0.3)
-    return emu, config, synthetic_truth(emu, ["toy"], config, trials=3, seed=4, n_live=100, n_eff=300)
+    return emu, config, synthetic_truth(emu, ["toy"], _settings(config, 100, 300), trials=3, seed=4)
 
 
 def test_log_posterior_matches_the_gaussian_formula(small_config):
@@ -102,7 +118,7 @@ def test_shot_without_emulator_is_rejected(small_config):
     emu = ShotEmulator(small_config, shots=["104S"])
     obs = pd.DataFrame([{"shot": "106S", **dict.fromkeys(FEATURES, 100.0)}])
     with pytest.raises(InputError, match="no shot"):
-        calibrate(emu, ["106S"], obs, small_config, n_samples=100)
+        calibrate(emu, ["106S"], obs, CalibrationSettings.from_config(small_config, ["106S"]))
 
 
 def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
@@ -117,7 +133,7 @@ def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
 def test_synthetic_truth_in_batches_equals_one_run(three_toy_trials):
     # each trial has its own random stream: the workflow's batches of trials are independent jobs
     emu, config, whole = three_toy_trials
-    batches = [synthetic_truth(emu, ["toy"], config, trials=range(*r), seed=4, n_live=100, n_eff=300)
+    batches = [synthetic_truth(emu, ["toy"], _settings(config, 100, 300), trials=range(*r), seed=4)
                for r in [(2, 3), (0, 2)]]
     merged = pd.concat(batches).sort_values("trial", kind="stable").reset_index(drop=True)
     pd.testing.assert_frame_equal(merged, whole)
@@ -128,7 +144,7 @@ def test_hydro_truth_needs_a_usable_run_per_trial(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
     truths, _ = _toy_hydro_truths(emu, small_config, n_runs=5)     # 3 usable runs
     with pytest.raises(InputError, match="trial 3 needs hydrocode run number 4, but only 3"):
-        synthetic_truth(emu, ["toy"], small_config, trials=range(2, 4), seed=4, truths=truths)
+        synthetic_truth(emu, ["toy"], _settings(small_config), trials=range(2, 4), seed=4, truths=truths)
 
 
 def test_coverage_command_merges_batches_and_rejects_a_repeated_trial(tmp_path, capsys):
@@ -157,7 +173,7 @@ def test_coverage_command_merges_batches_and_rejects_a_repeated_trial(tmp_path, 
 def test_synthetic_truth_coverage_is_near_nominal(small_config):
     # A two-input shot and 40 trials (about 5 min: nautilus costs a few seconds per run even on a toy).
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
-    trials = synthetic_truth(emu, ["toy"], small_config, trials=40, seed=4, n_live=100, n_eff=300)
+    trials = synthetic_truth(emu, ["toy"], _settings(small_config, 100, 300), trials=40, seed=4)
     table = coverage_table(trials)
     assert (table["trials"] == 40).all(), table
     assert table["within_band"].all() and table["band_low"].iloc[0] == pytest.approx(0.8), table
@@ -167,7 +183,7 @@ def test_synthetic_truth_coverage_is_near_nominal(small_config):
 @pytest.mark.slow
 def test_synthetic_truth_coverage_hundred_trials_within_the_binomial_band(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
-    table = coverage_table(synthetic_truth(emu, ["toy"], small_config, trials=100, seed=4, n_live=100, n_eff=300))
+    table = coverage_table(synthetic_truth(emu, ["toy"], _settings(small_config, 100, 300), trials=100, seed=4))
     assert table["within_band"].all() and table["band_low"].iloc[0] == pytest.approx(0.84), table
 
 
@@ -199,8 +215,7 @@ def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
 def test_hydro_truth_coverage_is_near_nominal(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
     truths, _ = _toy_hydro_truths(emu, small_config)
-    trials = synthetic_truth(emu, ["toy"], small_config, trials=40, seed=5, truths=truths, n_live=100,
-                             n_eff=300)
+    trials = synthetic_truth(emu, ["toy"], _settings(small_config, 100, 300), trials=40, seed=5, truths=truths)
     assert trials["trial"].nunique() == 40
     assert 0.84 <= trials["inside"].mean() <= 0.96, coverage_table(trials)
 
@@ -208,7 +223,7 @@ def test_hydro_truth_coverage_is_near_nominal(small_config):
 @pytest.mark.slow
 def test_synthetic_truth_coverage_eight_inputs(small_config):
     emu = ShotEmulator(small_config, shots=["105S"], emulator_sd=0.3)
-    trials = synthetic_truth(emu, ["105S"], small_config, trials=100, seed=4, n_live=500, n_eff=1000)
+    trials = synthetic_truth(emu, ["105S"], _settings(small_config, 500, 1000), trials=100, seed=4)
     table = coverage_table(trials)
     print(table.to_string())
     assert table["within_band"].all(), table

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.calibration import calibrate
+from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.cli import main, parse_pairs, parse_span
 from shockcal.config import load_config, validate_config
 from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
@@ -221,7 +221,8 @@ OBSERVED_FAULTS = {
 def test_observed_table_faults(paper_config, fault):
     table, fragments = OBSERVED_FAULTS[fault]
     with pytest.raises(InputError) as err:
-        calibrate(StandInEmulator(), ["104S"], table, paper_config, source="obs.csv")
+        calibrate(StandInEmulator(), ["104S"], table, CalibrationSettings.from_config(paper_config, ["104S"]),
+                  source="obs.csv")
     for fragment in ["obs.csv", *fragments]:
         assert fragment in str(err.value)
 

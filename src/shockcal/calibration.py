@@ -17,8 +17,8 @@ Sampling (`shockcal.sampler`): importance nested sampling (nautilus) from the un
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -147,6 +147,30 @@ class SamplerSettings:
     seed: int = 0
 
 
+@dataclass(frozen=True)
+class CalibrationSettings:
+    """What a calibration needs besides the emulator and the measured features: the sampler, the
+    observation sd as a fraction of each measured feature, whether to check that the measurements
+    look like m/s and us (`shockcal.plausibility`), and each parameter's unit for the summary."""
+
+    sampler: SamplerSettings = SamplerSettings()
+    sd_fraction: float = 0.01
+    check_units: bool = True
+    units: Mapping[str, str] = field(default_factory=dict)
+
+    @classmethod
+    def from_config(cls, config: dict, shots, check: bool = False) -> CalibrationSettings:
+        """The adapter from a validated config: `calibration` (with `check`, the synthetic-truth
+        trials' `calibration.check`, whose draws are its n_eff), seeded by the shots' "calibration"
+        stream of study.seed (a trial reseeds from its own stream)."""
+        section = config["calibration"]["check"] if check else config["calibration"]
+        draws = section["n_eff"] if check else section["draws"]
+        seed = stream_seed(config["study"]["seed"], "calibration", *shots)
+        return cls(SamplerSettings(section["n_live"], section["n_eff"], draws, seed),
+                   config["observed"]["sd_fraction"], config["checks"]["observed_units"],
+                   {name: box["unit"] for name, box in config["inputs"].items()})
+
+
 def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood) resampled from the
     weighted ones, the summary of the weighted draws, and run info (evidence, likelihood
@@ -204,27 +228,21 @@ def weighted_quantiles(x: np.ndarray, w: np.ndarray, q) -> np.ndarray:
     return np.interp(q, cdf / w.sum(), x[order])
 
 
-def calibrate(emulator, shots, observed: pd.DataFrame, config: dict, source: str = "observed",
-              **overrides) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
-    """Calibrate `shots` jointly (one shot = single-shot calibration): samples, summary, run info.
-
-    `overrides` replace keys of config["calibration"] (n_live, n_eff, draws) or set the sampler `seed`
-    (default: the "calibration" stream of study.seed, keyed by the shots).
-    """
-    problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"], source)
-    check_observed_table(observed, shots, source, config["checks"]["observed_units"])
-    calibration = {**config["calibration"], **{k: v for k, v in overrides.items() if v is not None}}
-    seed = calibration.get("seed", stream_seed(config["study"]["seed"], "calibration", *shots))
-    settings = SamplerSettings(calibration["n_live"], calibration["n_eff"], calibration["draws"], seed)
-    samples, summary, info = sample(problem, settings)
-    units = {**{k: config["inputs"][k]["unit"] for k in problem.names}, "lambda_y": "-"}
+def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSettings, source: str = "observed"
+              ) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """Calibrate `shots` jointly (one shot = single-shot calibration) on the measured features in
+    `observed` (one row per shot, m/s and us; `source` names it in errors): samples, summary, run info."""
+    problem = Problem.build(emulator, shots, observed, settings.sd_fraction, source)
+    check_observed_table(observed, shots, source, settings.check_units)
+    samples, summary, info = sample(problem, settings.sampler)
+    units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
     summary.insert(1, "unit", summary["parameter"].map(units))
     info.update(shots=list(shots), parameters=problem.names, units=units,
                 observed=problem.observed.tolist(), observed_sd_m_s=problem.obs_sd.tolist())
     return samples, summary, info
 
 
-def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=None, **overrides) -> pd.DataFrame:
+def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None) -> pd.DataFrame:
     """Calibrate on synthetic truth with a known theta; one row per trial and parameter.
 
     `trials` is a count or the trial numbers to run (a range): each trial draws from its own random
@@ -233,12 +251,13 @@ def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=Non
     noise-free features either from the emulator (theta uniform on the box, features from its
     predictive distribution at theta) or, when `truths` is given, from hydrocode run number `trial`
     among the usable ones (`HydroTruths`). Observation noise of sd = sd_fraction / sqrt(lambda_y) of
-    each feature is added and the features are calibrated (`overrides` as in `calibrate`). Columns:
+    each feature is added and the features are calibrated with `settings` (the sampler reseeded from
+    the trial's stream). Columns:
     trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS).
     """
     trial_ids = range(trials) if isinstance(trials, int) else trials
     names = emulator.required_inputs(shots)
-    sd_fraction = config["observed"]["sd_fraction"]
+    sd_fraction = settings.sd_fraction
     hydro_draws = None if truths is None else truths.table(names, shots)
     if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
@@ -252,8 +271,8 @@ def synthetic_truth(emulator, shots, config: dict, trials, seed: int, truths=Non
             theta, eta = hydro_draws[trial]
         lam, y = _noisy_features(eta, sd_fraction, rng, trial)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
-        _, summary, _ = calibrate(emulator, shots, observed, config, source=f"synthetic trial {trial}",
-                                  seed=int(rng.integers(2**31)), **overrides)
+        trial_settings = replace(settings, sampler=replace(settings.sampler, seed=int(rng.integers(2**31))))
+        _, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
         summary = summary.set_index("parameter")
         for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
             q05, q95 = summary.loc[name, ["q05", "q95"]]
@@ -332,9 +351,8 @@ def coverage_check(emulator, shots, config: dict, trials: int | range | None = N
     """The configured synthetic-truth check (calibration.check), on emulator or hydrocode truth:
     per-trial table and coverage per parameter. `trials`: a count or the trial numbers of one batch
     (default: all `calibration.check.trials`)."""
-    check = config["calibration"]["check"]
     truth = "emulator" if truths is None else "hydrocode"
-    table = synthetic_truth(emulator, shots, config, trials or check["trials"],
-                            seed=stream_seed(config["study"]["seed"], "check", truth, *shots), truths=truths,
-                            n_live=check["n_live"], n_eff=check["n_eff"], draws=check["n_eff"])
+    table = synthetic_truth(emulator, shots, CalibrationSettings.from_config(config, shots, check=True),
+                            trials or config["calibration"]["check"]["trials"],
+                            seed=stream_seed(config["study"]["seed"], "check", truth, *shots), truths=truths)
     return table, coverage_table(table)

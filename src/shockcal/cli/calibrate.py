@@ -44,8 +44,9 @@ def summary_path(out):
 
 def run(args) -> int:
     import logging
+    from dataclasses import replace
 
-    from shockcal.calibration import calibrate
+    from shockcal.calibration import CalibrationSettings, calibrate
     from shockcal.emulator import Emulator
     from shockcal.io import read_table, write_table
     from shockcal.stages import load_stage_config
@@ -53,8 +54,10 @@ def run(args) -> int:
     config = load_stage_config(args.config, "calibrate")
     emulator = Emulator.load(args.emulator)
     observed = read_table(args.observed)
-    samples, summary, info = calibrate(emulator, args.shots, observed, config, source=args.observed,
-                                       n_eff=args.n_eff)
+    settings = CalibrationSettings.from_config(config, args.shots)
+    if args.n_eff is not None:
+        settings = replace(settings, sampler=replace(settings.sampler, n_eff=args.n_eff))
+    samples, summary, info = calibrate(emulator, args.shots, observed, settings, source=args.observed)
     meta = {"table": "posterior samples", **info,
             "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
                        "log_likelihood (at the draw)"}
