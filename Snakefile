@@ -7,8 +7,8 @@ from shockcal.config import validate_or_exit
 configfile: "config/config.yaml"
 
 
-# snakemake's `validate` against workflow/schemas/config.schema.yaml (defaults filled in), then the
-# cross-field rules and the design file's contents; a bad config ends snakemake with its message
+# jsonschema against workflow/schemas/config.schema.yaml (the package's schema; defaults filled in), then
+# the cross-field rules and the design file's contents; a bad config ends snakemake with its message
 # alone, naming the key path: "shockcal: error: config: simulate.chunk_size: 0 is less than ..."
 validate_or_exit(config, source="config")
 

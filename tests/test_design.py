@@ -70,3 +70,16 @@ def test_design_depends_on_inputs_and_seed_not_on_their_order(paper_config):
     assert list(a.columns) == ["run", *paper_config["inputs"]]
     pd.testing.assert_frame_equal(a, b[a.columns])
     assert chunk_fingerprints(a, 10) == chunk_fingerprints(b, 10)
+
+
+def test_write_design_rewrites_only_changed_rows(paper_config, tmp_path):
+    """The workflow writes the design every time it is read: the same rows leave the file (and its
+    mtime, which the emulator's rerun follows) alone, from any source; other rows replace it."""
+    from shockcal.design import write_design
+
+    design, path = latin_hypercube(paper_config, 6, seed=1), tmp_path / "design.parquet"
+    assert write_design(design, "Latin hypercube, seed 1", paper_config, path)
+    assert not write_design(design.copy(), "file saved.csv", paper_config, path)
+    grown = pd.concat([design, latin_hypercube(paper_config, 1, seed=2).assign(run=6)], ignore_index=True)
+    assert write_design(grown, "file saved.csv", paper_config, path)
+    assert pd.read_parquet(path).equals(grown[["run", *design.columns[1:]]])

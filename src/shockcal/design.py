@@ -140,9 +140,21 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
     return latin_hypercube(config, n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
 
 
-def planned_design(config: dict) -> pd.DataFrame:
-    """The study's design as `shockcal design` writes it (the Snakefile plans its chunks from it)."""
-    return study_design(config)[0]
+def write_design(design: pd.DataFrame, source: str, config: dict, path: str | Path) -> bool:
+    """Write a design table (run + the config's inputs, with their units and `source` in the
+    metadata) unless `path` already holds the same rows and columns; True when it wrote. Same rows
+    from another source (a hypercube saved as a design file) leave the file, its mtime and what
+    depends on it alone; its metadata keeps the first source."""
+    from shockcal.io import write_table
+
+    table = design[["run", *input_names(config)]].reset_index(drop=True)
+    meta = {"table": "design", "source": source,
+            "units": {name: config["inputs"][name]["unit"] for name in input_names(config)}}
+    path = Path(path)
+    if path.is_file() and pd.read_parquet(path).equals(table):
+        return False
+    write_table(table, path, meta)
+    return True
 
 
 def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:

@@ -25,15 +25,6 @@ def chunk_count(n_runs: int, chunk_size: int) -> int:
     return -(-n_runs // chunk_size)
 
 
-def check_truth_inputs(truth: str, results: str, shots) -> dict:
-    """Inputs of a coverage-check batch besides the emulator: for hydrocode truth the check design
-    and its runs' features per shot; for emulator truth none."""
-    if truth == "emulator":
-        return {}
-    return {"design": f"{results}/check/design.parquet",
-            "features": [f"{results}/check/features/{shot}.parquet" for shot in shots]}
-
-
 def export_to_jobs(effective_config: str) -> None:
     """Environment every job inherits: the merged config as $SHOCKCAL_CONFIG (the default of
     `shockcal --config`), and the directory of the Python running snakemake first on PATH, so rules

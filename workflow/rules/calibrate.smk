@@ -5,8 +5,8 @@ CALIBRATIONS = [*SHOTS, "joint"]
 
 rule calibrate:
     input:
-        emulator=f"{RESULTS}/emulator/emulator.json",
-        observed=f"{RESULTS}/features/observed.parquet",
+        emulator=rules.emulator.output.emulator,
+        observed=rules.observed.output[0],
     output:
         samples=f"{RESULTS}/posterior/{{name}}.parquet",
         summary=f"{RESULTS}/posterior/{{name}}_summary.parquet",
@@ -37,8 +37,18 @@ rule calibration_check_batch:
     """One batch of synthetic-truth trials (each trial has its own random stream, so batches are
     independent jobs and together give what one run of every trial gives)."""
     input:
-        unpack(lambda w: check_truth_inputs(w.truth, RESULTS, SHOTS)),
-        emulator=f"{RESULTS}/emulator/emulator.json",
+        # hydrocode truth also reads the check design and its runs' features (predict.smk's run set "check")
+        unpack(
+            lambda w: (
+                {}
+                if w.truth == "emulator"
+                else {
+                    "design": rules.check_design.output[0],
+                    "features": expand(rules.run_set_features.output[0], run_set="check", shot=SHOTS),
+                }
+            )
+        ),
+        emulator=rules.emulator.output.emulator,
     output:
         f"{RESULTS}/check/coverage/{{truth}}/batch-{{batch}}.parquet",
     log:
@@ -70,7 +80,7 @@ rule calibration_check_batch:
 rule coverage:
     """Every batch of one check merged: one row per trial and parameter; the log has the coverage table."""
     input:
-        expand(f"{RESULTS}/check/coverage/{{{{truth}}}}/batch-{{batch}}.parquet", batch=CHECK_BATCHES),
+        expand(rules.calibration_check_batch.output[0], batch=CHECK_BATCHES, allow_missing=True),
     output:
         f"{RESULTS}/posterior/coverage_{{truth}}.parquet",
     log:
@@ -83,8 +93,8 @@ rule coverage:
         "shockcal coverage --trials {input} --out {output} > {log} 2>&1"
 
 
-ALL_TARGETS += expand(f"{RESULTS}/posterior/{{name}}_summary.parquet", name=CALIBRATIONS)
-CHECK_TARGETS = expand(f"{RESULTS}/posterior/coverage_{{truth}}.parquet", truth=CHECK_TRUTHS)
+ALL_TARGETS += expand(rules.calibrate.output.summary, name=CALIBRATIONS)
+CHECK_TARGETS = expand(rules.coverage.output[0], truth=CHECK_TRUTHS)
 
 
 rule check:

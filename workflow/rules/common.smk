@@ -5,10 +5,9 @@ import os
 import yaml
 
 from shockcal.config import shot_inputs
-from shockcal.design import chunk_fingerprints, planned_design
+from shockcal.design import chunk_fingerprints, study_design, write_design
 from shockcal.stages import figure_config, stage_config
 from shockcal.workflow import (
-    check_truth_inputs,
     chunk_count,
     chunk_rows,
     export_to_jobs,
@@ -27,13 +26,6 @@ write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
 export_to_jobs(EFFECTIVE_CONFIG)
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
-# per shot, over the run ids and the columns that shot reads: a column added for a new shot (its
-# impact velocity) leaves every other shot's chunks alone
-_PLANNED_DESIGN = planned_design(config)
-CHUNK_DIGESTS = {
-    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_inputs(config, shot)]], CHUNK_SIZE) for shot in SHOTS
-}
-CHUNKS = list(range(chunk_count(len(_PLANNED_DESIGN), CHUNK_SIZE)))
 
 LOGS = f"{RESULTS}/logs"
 BENCHMARKS = f"{RESULTS}/benchmarks"

@@ -1,16 +1,15 @@
-# Design: the seeded Latin hypercube over the prior box, or the config's design file.
-
-
-rule design:
-    output:
-        f"{RESULTS}/design.parquet",
-    log:
-        f"{LOGS}/design.log",
-    benchmark:
-        f"{BENCHMARKS}/design.tsv"
-    conda:
-        "../envs/shockcal.yaml"
-    params:
-        settings=stage_config(config, "design"),
-    shell:
-        "shockcal design --out {output} > {log} 2>&1"
+# Design: the seeded Latin hypercube over the prior box, or the config's design file (checked
+# against it). It is made here, when the workflow is read, not by a job: the chunks are planned from
+# it, and `write_design` rewrites results/design.parquet only when its content changes. (A design
+# job would be an `ancient` input of every chunk, and snakemake drops the jobs downstream of an
+# `ancient` input whose producer reruns in the same invocation, snakemake/snakemake#4166: appended
+# rows ran on the second call only.) `shockcal design` writes the same table outside the workflow.
+DESIGN = f"{RESULTS}/design.parquet"
+_PLANNED_DESIGN, _DESIGN_SOURCE = study_design(config)
+write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, config, DESIGN)
+# a digest per shot and chunk, over the run ids and the columns that shot reads: a column added for
+# a new shot (its impact velocity) leaves every other shot's chunks alone
+CHUNK_DIGESTS = {
+    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_inputs(config, shot)]], CHUNK_SIZE) for shot in SHOTS
+}
+CHUNKS = list(range(chunk_count(len(_PLANNED_DESIGN), CHUNK_SIZE)))

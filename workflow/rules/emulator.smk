@@ -5,8 +5,8 @@
 
 rule emulator:
     input:
-        design=f"{RESULTS}/design.parquet",
-        features=expand(f"{RESULTS}/features/{{shot}}.parquet", shot=SHOTS),
+        design=DESIGN,
+        features=expand(rules.features.output[0], shot=SHOTS),
     output:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",
@@ -28,4 +28,4 @@ rule emulator:
         "shockcal emulate --design {input.design} --features {params.pairs}" " --out {params.out} > {log} 2>&1"
 
 
-ALL_TARGETS.append(f"{RESULTS}/emulator/cv_rmse.csv")
+ALL_TARGETS.append(rules.emulator.output.rmse)

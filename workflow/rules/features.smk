@@ -4,7 +4,7 @@
 
 rule features_chunk:
     input:
-        f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
+        rules.simulate.output[0],
     output:
         f"{RESULTS}/features/{{shot}}/chunk-{{chunk}}.parquet",
     log:
@@ -21,7 +21,7 @@ rule features_chunk:
 
 rule features:
     input:
-        expand(f"{RESULTS}/features/{{{{shot}}}}/chunk-{{chunk}}.parquet", chunk=CHUNKS),
+        expand(rules.features_chunk.output[0], chunk=CHUNKS, allow_missing=True),
     output:
         f"{RESULTS}/features/{{shot}}.parquet",
     log:
@@ -55,5 +55,5 @@ rule observed:
         "shockcal observed --out {output} > {log} 2>&1"
 
 
-ALL_TARGETS += expand(f"{RESULTS}/features/{{shot}}.parquet", shot=SHOTS)
-ALL_TARGETS.append(f"{RESULTS}/features/observed.parquet")
+ALL_TARGETS += expand(rules.features.output[0], shot=SHOTS)
+ALL_TARGETS += rules.observed.output

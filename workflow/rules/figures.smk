@@ -9,12 +9,17 @@ HISTORY_SHOTS = history_names(config)
 FIGURE_FORMATS = config["figures"]["formats"]
 REPORT_FORMAT = "png" if "png" in FIGURE_FORMATS else FIGURE_FORMATS[0]
 RECORD_FILES = {shot: [spec["path"]] for shot, spec in config["observed"]["records"].items()}
-OBSERVED_FEATURES = f"{RESULTS}/features/observed.parquet"
-SIMULATION_CHUNKS = {shot: [f"{RESULTS}/simulations/{shot}/chunk-{k}.parquet" for k in CHUNKS] for shot in SHOTS}
+OBSERVED_FEATURES = rules.observed.output[0]
+SIMULATION_CHUNKS = {shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS) for shot in SHOTS}
 PREDICTED_SIMULATION_CHUNKS = {
-    shot: [f"{PREDICT}/simulations/{shot}/chunk-{k}.parquet" for k in PREDICT_CHUNKS] for shot in SHOTS
+    shot: expand(rules.run_set_simulate.output[0], run_set="predict", shot=shot, chunk=PREDICT_CHUNKS) for shot in SHOTS
 }
-TRAINING_FEATURES = {f"features:{shot}": [f"{RESULTS}/features/{shot}.parquet"] for shot in SHOTS}
+TRAINING_FEATURES = {f"features:{shot}": expand(rules.features.output[0], shot=shot) for shot in SHOTS}
+PREDICTED_FEATURES = {
+    f"predicted_features:{shot}": expand(rules.run_set_features.output[0], run_set="predict", shot=shot)
+    for shot in SHOTS
+}
+POSTERIOR = {f"posterior:{name}": expand(rules.calibrate.output.samples, name=name) for name in CALIBRATIONS}
 # Figs 4, 5, 15 draw one trace: the first shot's record when configured, else its first simulation chunk.
 TRACE_INPUTS = (
     {f"record:{SHOTS[0]}": RECORD_FILES[SHOTS[0]]}
@@ -25,18 +30,18 @@ FIGURE_INPUTS = {
     "fig02_records": {"observed": [OBSERVED_FEATURES], **{f"record:{s}": p for s, p in RECORD_FILES.items()}},
     "fig04_trace_features": TRACE_INPUTS,
     "fig05_mixture_split": TRACE_INPUTS,
-    "fig06_crossval": {"cv": [f"{RESULTS}/emulator/cv.parquet"]},
-    "fig07_marginals": {f"posterior:{n}": [f"{RESULTS}/posterior/{n}.parquet"] for n in [*SHOTS, "joint"]},
-    "fig08_pairs": {"posterior:joint": [f"{RESULTS}/posterior/joint.parquet"]},
+    "fig06_crossval": {"cv": [rules.emulator.output.cv]},
+    "fig07_marginals": POSTERIOR,
+    "fig08_pairs": {"posterior:joint": POSTERIOR["posterior:joint"]},
     "fig09_features_emulator": {
         **TRAINING_FEATURES,
         "observed": [OBSERVED_FEATURES],
-        "emulator_predictions": [f"{PREDICT}/emulator.parquet"],
+        "emulator_predictions": rules.predict_emulator.output,
     },
     "fig10_features_hydrocode": {
         **TRAINING_FEATURES,
         "observed": [OBSERVED_FEATURES],
-        **{f"predicted_features:{s}": [f"{PREDICT}/features/{s}.parquet"] for s in SHOTS},
+        **PREDICTED_FEATURES,
     },
     "fig15_pit_construction": TRACE_INPUTS,
     **{
@@ -44,8 +49,8 @@ FIGURE_INPUTS = {
             "observed": [OBSERVED_FEATURES],
             f"simulations:{shot}": SIMULATION_CHUNKS[shot],
             f"predicted_simulations:{shot}": PREDICTED_SIMULATION_CHUNKS[shot],
-            f"features:{shot}": [f"{RESULTS}/features/{shot}.parquet"],
-            f"predicted_features:{shot}": [f"{PREDICT}/features/{shot}.parquet"],
+            f"features:{shot}": TRAINING_FEATURES[f"features:{shot}"],
+            f"predicted_features:{shot}": PREDICTED_FEATURES[f"predicted_features:{shot}"],
             **({f"record:{shot}": RECORD_FILES[shot]} if shot in RECORD_FILES else {}),
         }
         for name, shot in HISTORY_SHOTS.items()

@@ -12,7 +12,7 @@ PREDICT_CHUNKS = RUN_SET_CHUNKS["predict"]
 
 rule predict_design:
     input:
-        posterior=f"{RESULTS}/posterior/joint.parquet",
+        posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
         f"{PREDICT}/design.parquet",
     log:
@@ -67,7 +67,7 @@ rule run_set_simulate:
 rule run_set_features:
     input:
         lambda w: expand(
-            f"{RESULTS}/{w.run_set}/simulations/{w.shot}/chunk-{{chunk}}.parquet", chunk=RUN_SET_CHUNKS[w.run_set]
+            rules.run_set_simulate.output[0], run_set=w.run_set, shot=w.shot, chunk=RUN_SET_CHUNKS[w.run_set]
         ),
     output:
         f"{RESULTS}/{{run_set}}/features/{{shot}}.parquet",
@@ -87,9 +87,9 @@ rule run_set_features:
 
 rule predict_emulator:
     input:
-        design=f"{PREDICT}/design.parquet",
-        emulator=f"{RESULTS}/emulator/emulator.json",
-        arrays=f"{RESULTS}/emulator/emulator.npz",
+        design=rules.predict_design.output[0],
+        emulator=rules.emulator.output.emulator,
+        arrays=rules.emulator.output.arrays,
     output:
         f"{PREDICT}/emulator.parquet",
     log:

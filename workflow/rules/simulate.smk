@@ -5,7 +5,7 @@
 
 rule simulate:
     input:
-        design=ancient(f"{RESULTS}/design.parquet"),
+        design=ancient(DESIGN),
     output:
         f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
     log:

@@ -22,9 +22,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import input_names
-    from shockcal.design import study_design
-    from shockcal.io import write_table
+    from shockcal.design import study_design, write_design
     from shockcal.stages import load_stage_config
 
     config = load_stage_config(args.config, args.stream)  # the design or check_design stage
@@ -33,8 +31,6 @@ def run(args) -> int:
     else:
         n_runs, lhs = args.n_runs, args.lhs
     design, source = study_design(config, n_runs, args.seed, args.stream, lhs)
-    units = {name: config["inputs"][name]["unit"] for name in input_names(config)}
-    write_table(design[["run", *input_names(config)]], args.out,
-                {"table": "design", "source": source, "units": units})
+    write_design(design, source, config, args.out)
     logging.getLogger("shockcal.design").info("wrote %d runs (%s) to %s", len(design), source, args.out)
     return 0
