@@ -12,7 +12,7 @@ from matplotlib.image import imread
 from shockcal.cli import main
 from shockcal.cli.figures import parse_inputs
 from shockcal.errors import InputError
-from shockcal.plots.catalogue import FigureInputs, build_figure, catalogue, history_names
+from shockcal.plots.catalogue import INPUT_KINDS, FigureInputs, build_figure, catalogue, history_names
 from shockcal.plots.style import save_figure
 
 CONFIG = str(Path(__file__).resolve().parents[1] / "config" / "config.yaml")
@@ -42,6 +42,23 @@ def test_data_figures_without_inputs_say_no_data(name, jc_config, tmp_path):
                for ax in fig.axes for t in ax.texts), name
     (png,) = save_figure(fig, tmp_path / name, ["png"], dpi=30)
     assert imread(png).shape[0] > 30
+
+
+def test_needs_name_known_kinds_and_follow_the_configured_records(paper_config):
+    """The workflow builds each figure's inputs from `needs`: every key is a known kind, and a shot
+    without a record draws its trace figures from a simulation sample instead."""
+    specs = catalogue(paper_config)
+    assert {key.partition(":")[0] for spec in specs.values() for key in spec.needs} <= set(INPUT_KINDS)
+    assert specs["fig04_trace_features"].needs == ("record:104S",)
+    assert "record:105S" in specs["fig02_records"].needs
+    assert set(specs["fig07_marginals"].needs) == {"posterior:104S", "posterior:105S", "posterior:106S",
+                                                   "posterior:joint"}
+    config = copy.deepcopy(paper_config)
+    del config["observed"]["records"]["104S"]
+    specs = catalogue(config)
+    assert specs["fig04_trace_features"].needs == ("sample_simulations:104S",)
+    assert "record:104S" not in specs["fig02_records"].needs + specs["fig11_history_104S"].needs
+    assert "record:105S" in specs["fig12_history_105S"].needs
 
 
 def test_unknown_figure_is_named(paper_config):

@@ -1,65 +1,38 @@
 # The paper's fifteen figures (issue 7), one rule per figure, each `shockcal figures --figure NAME`
-# with its inputs passed as KEY=PATH pairs (keys: see shockcal.plots.catalogue). PNG and PDF
-# (figures.formats) under {RESULTS}/figures/; the PNG goes into the report with a caption from
-# workflow/report/. Figure names and categories come from the catalogue, the files from here.
-from shockcal.plots.catalogue import catalogue, history_names
+# with its inputs passed as KEY=PATH pairs. PNG and PDF (figures.formats) under {RESULTS}/figures/;
+# the PNG goes into the report with a caption from workflow/report/. The figures, their categories
+# and the input keys each needs come from the catalogue (shockcal.plots.catalogue); this file only
+# says which files make each kind of input.
+from shockcal.plots.catalogue import INPUT_KINDS, catalogue, history_names
 
 FIGURE_SPECS = catalogue(config)
 HISTORY_SHOTS = history_names(config)
 FIGURE_FORMATS = config["figures"]["formats"]
 REPORT_FORMAT = "png" if "png" in FIGURE_FORMATS else FIGURE_FORMATS[0]
-RECORD_FILES = {shot: [spec["path"]] for shot, spec in config["observed"]["records"].items()}
-OBSERVED_FEATURES = rules.observed.output[0]
-SIMULATION_CHUNKS = {shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS) for shot in SHOTS}
-PREDICTED_SIMULATION_CHUNKS = {
-    shot: expand(rules.run_set_simulate.output[0], run_set="predict", shot=shot, chunk=PREDICT_CHUNKS) for shot in SHOTS
+# input kind -> (shot or calibration name -> files)
+INPUT_FILES = {
+    "observed": lambda _: [rules.observed.output[0]],
+    "cv": lambda _: [rules.emulator.output.cv],
+    "emulator_predictions": lambda _: [rules.predict_emulator.output[0]],
+    "record": lambda shot: [config["observed"]["records"][shot]["path"]],
+    "sample_simulations": lambda shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS[:1]),
+    "simulations": lambda shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS),
+    "predicted_simulations": lambda shot: expand(
+        rules.run_set_simulate.output[0], run_set="predict", shot=shot, chunk=PREDICT_CHUNKS
+    ),
+    "features": lambda shot: [rules.features.output[0].format(shot=shot)],
+    "predicted_features": lambda shot: expand(rules.run_set_features.output[0], run_set="predict", shot=shot),
+    "posterior": lambda name: [rules.calibrate.output.samples.format(name=name)],
 }
-TRAINING_FEATURES = {f"features:{shot}": expand(rules.features.output[0], shot=shot) for shot in SHOTS}
-PREDICTED_FEATURES = {
-    f"predicted_features:{shot}": expand(rules.run_set_features.output[0], run_set="predict", shot=shot)
-    for shot in SHOTS
-}
-POSTERIOR = {f"posterior:{name}": expand(rules.calibrate.output.samples, name=name) for name in CALIBRATIONS}
-# Figs 4, 5, 15 draw one trace: the first shot's record when configured, else its first simulation chunk.
-TRACE_INPUTS = (
-    {f"record:{SHOTS[0]}": RECORD_FILES[SHOTS[0]]}
-    if SHOTS[0] in RECORD_FILES
-    else {f"simulations:{SHOTS[0]}": SIMULATION_CHUNKS[SHOTS[0]][:1]}
-)
+assert set(INPUT_FILES) == set(INPUT_KINDS), "figures.smk: INPUT_FILES must cover the catalogue's INPUT_KINDS"
 FIGURE_INPUTS = {
-    "fig02_records": {"observed": [OBSERVED_FEATURES], **{f"record:{s}": p for s, p in RECORD_FILES.items()}},
-    "fig04_trace_features": TRACE_INPUTS,
-    "fig05_mixture_split": TRACE_INPUTS,
-    "fig06_crossval": {"cv": [rules.emulator.output.cv]},
-    "fig07_marginals": POSTERIOR,
-    "fig08_pairs": {"posterior:joint": POSTERIOR["posterior:joint"]},
-    "fig09_features_emulator": {
-        **TRAINING_FEATURES,
-        "observed": [OBSERVED_FEATURES],
-        "emulator_predictions": rules.predict_emulator.output,
-    },
-    "fig10_features_hydrocode": {
-        **TRAINING_FEATURES,
-        "observed": [OBSERVED_FEATURES],
-        **PREDICTED_FEATURES,
-    },
-    "fig15_pit_construction": TRACE_INPUTS,
-    **{
-        name: {
-            "observed": [OBSERVED_FEATURES],
-            f"simulations:{shot}": SIMULATION_CHUNKS[shot],
-            f"predicted_simulations:{shot}": PREDICTED_SIMULATION_CHUNKS[shot],
-            f"features:{shot}": TRAINING_FEATURES[f"features:{shot}"],
-            f"predicted_features:{shot}": PREDICTED_FEATURES[f"predicted_features:{shot}"],
-            **({f"record:{shot}": RECORD_FILES[shot]} if shot in RECORD_FILES else {}),
-        }
-        for name, shot in HISTORY_SHOTS.items()
-    },
+    name: {key: INPUT_FILES[key.partition(":")[0]](key.partition(":")[2]) for key in spec.needs}
+    for name, spec in FIGURE_SPECS.items()
 }
 
 
 for _name, _spec in FIGURE_SPECS.items():
-    _files = FIGURE_INPUTS.get(_name, {})
+    _files = FIGURE_INPUTS[_name]
 
     rule:
         name:

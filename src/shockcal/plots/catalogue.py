@@ -3,11 +3,12 @@
 Importing this module is cheap (the Snakefile lists the figures from it); plotting modules are
 imported when a figure is built.
 
-Inputs arrive as named files (`FigureInputs`): keys such as `observed`, `cv`, `emulator_predictions`
-or `<kind>:<shot or calibration>` (`posterior:joint`, `features:104S`, `simulations:104S`,
-`predicted_features:104S`, `predicted_simulations:104S`, `record:104S`); a key may name several
-files (simulation chunks), which are concatenated. A key that was not given reads as None and the
-figure shows a "no data" note; a given file that is missing or unreadable is an InputError.
+Inputs arrive as named files (`FigureInputs`): keys `<kind>` or `<kind>:<shot or calibration>`
+with the kinds of `INPUT_KINDS` (`observed`, `posterior:joint`, `features:104S`, ...); a key may
+name several files (simulation chunks), which are concatenated. A key that was not given reads as
+None and the figure shows a "no data" note; a given file that is missing or unreadable is an
+InputError. Each entry says which keys it `needs` for the config's shots, and the workflow
+(workflow/rules/figures.smk) maps every kind to the files that make it: adding a figure is one entry here.
 """
 
 from __future__ import annotations
@@ -22,6 +23,21 @@ from shockcal.seeds import stream_seed
 
 if TYPE_CHECKING:
     import pandas as pd
+
+
+# what each input kind is (the workflow's figures.smk maps every kind to its files)
+INPUT_KINDS = {
+    "observed": "the observed features (features/observed.parquet)",
+    "cv": "the emulator's cross-validation table (emulator/cv.parquet)",
+    "emulator_predictions": "emulator predictions at the posterior-predictive design",
+    "record": "a shot's measured VISAR record (observed.records.<shot>.path)",
+    "sample_simulations": "a sample of a shot's training runs: its first simulation chunk",
+    "simulations": "every training run of a shot (all simulation chunks)",
+    "predicted_simulations": "a shot's hydrocode runs at posterior draws (run set 'predict')",
+    "features": "a shot's training features",
+    "predicted_features": "the features of a shot's runs at posterior draws",
+    "posterior": "a calibration's posterior draws (a shot or 'joint')",
+}
 
 
 class FigureInputs:
@@ -67,6 +83,7 @@ class FigureSpec:
     category: str
     build: Callable  # (FigureInputs, config) -> matplotlib Figure
     reads: tuple[str, ...] = ()  # config keys `build` reads besides `figures` (shockcal.stages paths)
+    needs: tuple[str, ...] = ()  # FigureInputs keys `build` reads, for the config's shots (kinds: INPUT_KINDS)
 
 
 def _shots(config) -> list[str]:
@@ -90,7 +107,7 @@ def _trace_figure(which, inputs, config):
     from shockcal.plots import mixture
 
     shot = _shots(config)[0]
-    trace, label = mixture.pick_trace(inputs.record(shot, config), inputs.table(f"simulations:{shot}"), shot)
+    trace, label = mixture.pick_trace(inputs.record(shot, config), inputs.table(f"sample_simulations:{shot}"), shot)
     return getattr(mixture, which)(trace, label, config, shot)
 
 
@@ -158,21 +175,39 @@ _FEATURE_SPACE = ("shots", "observed.sd_fraction")
 
 def catalogue(config) -> dict[str, FigureSpec]:
     """Every figure of the study, in the paper's order (cheap: nothing is imported until a figure is built)."""
+    shots = _shots(config)
+    recorded = [s for s in shots if s in config.get("observed", {}).get("records", {})]
+
+    def per(kind, names):
+        return tuple(f"{kind}:{name}" for name in names)
+
+    # Figs 4, 5, 15 draw one trace: the first shot's record when configured, else one of its runs
+    trace = per("record" if shots[0] in recorded else "sample_simulations", shots[:1])
+    features = per("features", shots)
+
+    def history(shot):
+        runs = ("simulations", "predicted_simulations", "features", "predicted_features")
+        return ("observed", *(f"{kind}:{shot}" for kind in runs), *per("record", [shot] if shot in recorded else []))
+
     specs = [
         FigureSpec("fig01_toy_calibration", "1 method", partial(_toy, "fig01_toy_calibration")),
-        FigureSpec("fig02_records", "2 data", _records, _RECORDS),
+        FigureSpec("fig02_records", "2 data", _records, _RECORDS, ("observed", *per("record", recorded))),
         FigureSpec("fig03_gp_draws", "1 method", partial(_toy, "fig03_gp_draws")),
-        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features"), _TRACE),
-        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split"), _TRACE),
-        FigureSpec("fig06_crossval", "3 emulator", _crossval, ("shots",)),
-        FigureSpec("fig07_marginals", "4 posterior", _marginals, _POSTERIOR),
-        FigureSpec("fig08_pairs", "4 posterior", _pairs, _POSTERIOR),
-        FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator, _FEATURE_SPACE),
-        FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode, _FEATURE_SPACE),
-        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot), (*_RECORDS, "study.seed"))
+        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features"), _TRACE, trace),
+        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split"), _TRACE, trace),
+        FigureSpec("fig06_crossval", "3 emulator", _crossval, ("shots",), ("cv",)),
+        FigureSpec("fig07_marginals", "4 posterior", _marginals, _POSTERIOR, per("posterior", [*shots, "joint"])),
+        FigureSpec("fig08_pairs", "4 posterior", _pairs, _POSTERIOR, ("posterior:joint",)),
+        FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator, _FEATURE_SPACE,
+                   (*features, "observed", "emulator_predictions")),
+        FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode, _FEATURE_SPACE,
+                   (*features, "observed", *per("predicted_features", shots))),
+        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot), (*_RECORDS, "study.seed"),
+                     history(shot))
           for name, shot in history_names(config).items()),
         FigureSpec("fig14_inadequate_model", "1 method", partial(_toy, "fig14_inadequate_model")),
-        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), _TRACE),
+        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), _TRACE,
+                   trace),
     ]
     return {spec.name: spec for spec in specs}
 
