@@ -4,14 +4,18 @@ VENV := .venv
 PY := $(VENV)/bin/python
 INSTALLED := $(VENV)/.installed
 CORES ?= all
+# constraints.txt pins the environment the documented study ran with (Python 3.11); another Python
+# installs from pyproject.toml's ranges instead, with a warning
+LOCKED_PYTHON := 3.11
+CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick check test test-slow test-slurm bench validate lint clean
+.PHONY: study quick check test test-slow test-slurm bench validate lint lock clean
 
-$(INSTALLED): pyproject.toml
+$(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test]'
 	touch $@
 
 study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report
@@ -36,17 +40,23 @@ test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (r
 	tests/slurm/run_slurm_test.sh
 
 bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); installs the reference samplers
-	$(PY) -m pip install --quiet -e '.[test,bench]'
+	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,bench]'
 	@for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 validate: $(INSTALLED)  ## our hydrocode + extractor against the paper's FLAG features and measured features
 	$(PY) benchmarks/validate_flag.py
 
 lint: $(INSTALLED)  ## ruff on the package, tests and benchmarks; snakefmt and snakemake's own lint on the rules
-	$(PY) -m pip install --quiet -e '.[test,lint]'
+	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,lint]'
 	$(VENV)/bin/ruff check src tests benchmarks
 	$(VENV)/bin/snakefmt --check Snakefile workflow/
 	snakemake --lint
+
+lock:  ## refresh constraints.txt: the newest releases pyproject.toml allows, resolved in a throwaway venv
+	rm -rf .lock-venv && python3 -m venv .lock-venv
+	.lock-venv/bin/pip install --quiet -e '.[test,lint,bench]'
+	{ sed -n '/^#/p' constraints.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v -i '^shockcal'; } > constraints.new
+	mv constraints.new constraints.txt && rm -rf .lock-venv
 
 clean:
 	rm -rf results .snakemake

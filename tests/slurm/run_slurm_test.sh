@@ -11,7 +11,7 @@ PY=${PY:-.venv/bin/python}
 start=$(date +%s)
 
 tests/slurm/cluster.sh install
-"$PY" -c "import snakemake_executor_plugin_slurm" 2>/dev/null || "$PY" -m pip install --quiet -e '.[slurm]'
+"$PY" -c "import snakemake_executor_plugin_slurm" 2>/dev/null || "$PY" -m pip install --quiet -c constraints.txt -e '.[slurm]'
 
 WORK=$(mktemp -d /tmp/shockcal-slurm.XXXXXX)
 cleanup() {
