@@ -1,7 +1,4 @@
-"""Pure helpers of the Snakemake rule files (chunk slices, writes that keep mtimes).
-
-The environment jobs inherit is set in workflow/rules/common.smk.
-"""
+"""Helpers of the Snakemake rule files (kept here so the rule files hold rules only)."""
 
 from __future__ import annotations
 
@@ -26,3 +23,15 @@ def chunk_rows(chunk, chunk_size: int, total: int | None = None) -> str:
 
 def chunk_count(n_runs: int, chunk_size: int) -> int:
     return -(-n_runs // chunk_size)
+
+
+def export_to_jobs(effective_config: str) -> None:
+    """Environment every job inherits: the merged config as $SHOCKCAL_CONFIG (the default of
+    `shockcal --config`), and the directory of the Python running snakemake first on PATH, so rules
+    find the `shockcal` script even when that environment is not activated (`.venv/bin/snakemake`);
+    a conda env, when used, is activated in front of it."""
+    import os
+    import sys
+
+    os.environ["SHOCKCAL_CONFIG"] = effective_config
+    os.environ["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])

@@ -1,7 +1,6 @@
 # Shared helpers of the rule files: the effective config, chunking, config slices.
 import hashlib
 import os
-import sys
 
 import yaml
 
@@ -11,6 +10,7 @@ from shockcal.stages import figure_config, stage_config
 from shockcal.workflow import (
     chunk_count,
     chunk_rows,
+    export_to_jobs,
     write_if_changed,
 )
 
@@ -23,11 +23,7 @@ from shockcal.workflow import (
 _EFFECTIVE_TEXT = yaml.safe_dump(config, sort_keys=True)
 EFFECTIVE_CONFIG = f"{RESULTS}/config/effective-{hashlib.sha256(_EFFECTIVE_TEXT.encode()).hexdigest()[:12]}.yaml"
 write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
-# the environment every job inherits: the merged config, and the directory of the Python running
-# snakemake first on PATH, so rules find the `shockcal` script even when that environment is not
-# activated (`.venv/bin/snakemake`); a conda env, when used, is activated in front of it
-os.environ["SHOCKCAL_CONFIG"] = EFFECTIVE_CONFIG
-os.environ["PATH"] = os.pathsep.join([os.path.dirname(sys.executable), os.environ.get("PATH", "")])
+export_to_jobs(EFFECTIVE_CONFIG)
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
 
