@@ -1,4 +1,5 @@
-"""Helpers of the Snakemake rule files (kept here so the rule files hold rules only)."""
+"""Helpers of the Snakemake rule files (kept here so the rule files hold rules only; `snakemake
+--lint` also refuses os.environ in a rule file, hence `export_to_jobs`)."""
 
 from __future__ import annotations
 
