@@ -63,11 +63,6 @@ def reference(problem, name: str, directory: Path, n_live: int, n_eff: int) -> p
     return frame
 
 
-def quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> float:
-    """Worst |quantile - reference quantile| / box width over parameters and QUANTILES."""
-    return worst_quantile_error(points, ref, names, width)[0]
-
-
 def worst_quantile_error(points: np.ndarray, ref: pd.DataFrame, names, width) -> tuple[float, str]:
     """Worst |quantile - reference quantile| / box width over parameters and QUANTILES, and where."""
     worst, where = 0.0, ""
@@ -148,8 +143,8 @@ def run_dynesty(problem, n_live: int, seed: int, keep: Path):
                                     bound="multi", sample="rslice", rstate=rng)
     sampler.run_nested(dlogz=0.1, print_progress=False)
     result = sampler.results
-    log_weight = result.logwt - result.logz[-1]
-    weights = np.exp(log_weight) / np.exp(log_weight).sum()
+    weights = np.exp(result.logwt - result.logz[-1])
+    weights /= weights.sum()
     points = resample_equal(result.samples, weights, rstate=rng)
     keep.parent.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(result.samples, columns=[*problem.names, "lambda_y"]).assign(weight=weights).to_parquet(keep)
@@ -163,7 +158,8 @@ def report(label, runs, ref, names, width):
     """Print the measures of replicate runs [(points, wall, cpu, evaluations), ...]."""
     means = np.array([points.mean(axis=0) for points, *_ in runs])
     variance = np.array([np.cov(ref[n], aweights=ref["weight"]) for n in names])
-    errors = [quantile_error(points, ref, names, width) for points, *_ in runs]
+    worst = [worst_quantile_error(points, ref, names, width) for points, *_ in runs]
+    errors = [error for error, _ in worst]
     tip = [np.mean(points[:, names.index("A")] > TIP_A_MBAR) for points, *_ in runs] if "A" in names else [np.nan]
     wall = np.median([r[1] for r in runs])
     weighted = [r[4] for r in runs if len(r) > 4]
@@ -174,7 +170,7 @@ def report(label, runs, ref, names, width):
         print(f"  {label} ESS of the mean per parameter (replicate spread): "
               + ", ".join(f"{n} {e:.0f}" for n, e in zip(names, ess)) + f"; min {ess.min():.0f}")
     print(f"  {label} worst quantile error vs reference: median {np.median(errors):.4f}, max {np.max(errors):.4f} "
-          f"of the box ({worst_quantile_error(runs[int(np.argmax(errors))][0], ref, names, width)[1]}); "
+          f"of the box ({worst[int(np.argmax(errors))][1]}); "
           f"mass at A > 800 MPa {np.mean(tip):.3f} (reference "
           f"{ref['weight'][ref['A'] > TIP_A_MBAR].sum() if 'A' in names else np.nan:.3f})")
     for draws in weighted:
@@ -258,7 +254,7 @@ def main(argv=None) -> int:
             evaluations = 60000
             draws, seconds, rhat, ess_bulk = run_emcee(problem, evaluations, seed=1)
             print(f"  emcee, {evaluations} evaluations: {seconds:.1f} s, max R-hat {rhat:.3f}, min bulk ESS "
-                  f"{ess_bulk:.0f} (ArviZ), worst quantile error {quantile_error(draws, ref, names, width):.4f}")
+                  f"{ess_bulk:.0f} (ArviZ), worst quantile error {worst_quantile_error(draws, ref, names, width)[0]:.4f}")
     return 0
 
 

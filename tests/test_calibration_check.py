@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 import json
 import re
-from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -76,9 +75,7 @@ def mid_box(emulator, shots) -> dict:
 def _settings(config, n_live=None, n_eff=None):
     """The config's calibration settings, the sampler's live points and ESS replaced when given."""
     settings = CalibrationSettings.from_config(config, ["toy"])
-    sampler = replace(settings.sampler, n_live=n_live or settings.sampler.n_live,
-                      n_eff=n_eff or settings.sampler.n_eff)
-    return replace(settings, sampler=sampler)
+    return settings.with_sampler(n_live=n_live or settings.sampler.n_live, n_eff=n_eff or settings.sampler.n_eff)
 
 
 @pytest.fixture

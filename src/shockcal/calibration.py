@@ -170,6 +170,10 @@ class CalibrationSettings:
                    config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                    {name: box["unit"] for name, box in config["inputs"].items()})
 
+    def with_sampler(self, **changes) -> CalibrationSettings:
+        """These settings with some sampler settings changed (e.g. `seed`, `n_eff`)."""
+        return replace(self, sampler=replace(self.sampler, **changes))
+
 
 def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood) resampled from the
@@ -271,7 +275,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
             theta, eta = hydro_draws[trial]
         lam, y = _noisy_features(eta, sd_fraction, rng, trial)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
-        trial_settings = replace(settings, sampler=replace(settings.sampler, seed=int(rng.integers(2**31))))
+        trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
         _, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
         summary = summary.set_index("parameter")
         for name, truth in [*zip(names, theta), ("lambda_y", lam)]:

@@ -44,7 +44,6 @@ def summary_path(out):
 
 def run(args) -> int:
     import logging
-    from dataclasses import replace
 
     from shockcal.calibration import CalibrationSettings, calibrate
     from shockcal.emulator import Emulator
@@ -56,7 +55,7 @@ def run(args) -> int:
     observed = read_table(args.observed)
     settings = CalibrationSettings.from_config(config, args.shots)
     if args.n_eff is not None:
-        settings = replace(settings, sampler=replace(settings.sampler, n_eff=args.n_eff))
+        settings = settings.with_sampler(n_eff=args.n_eff)
     samples, summary, info = calibrate(emulator, args.shots, observed, settings, source=args.observed)
     meta = {"table": "posterior samples", **info,
             "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
