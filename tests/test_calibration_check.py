@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 from shockcal.calibration import (
     CalibrationSettings,
@@ -16,6 +17,9 @@ from shockcal.calibration import (
     Problem,
     calibrate,
     coverage_table,
+    hpd_mass,
+    joint_coverage,
+    log_density,
     synthetic_truth,
 )
 from shockcal.errors import InputError
@@ -120,11 +124,39 @@ def test_shot_without_emulator_is_rejected(small_config):
 
 def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
     _, _, trials = three_toy_trials
-    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess"]
+    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass"]
     assert len(trials) == 3 * 3 and (trials["q05"] < trials["q95"]).all() and (trials["ess"] >= 300).all()
+    per_trial = trials.groupby("trial")["truth_hpd_mass"]
+    assert (per_trial.nunique() == 1).all() and trials["truth_hpd_mass"].between(0.0, 1.0).all()
     table = coverage_table(pd.concat([trials] * 34, ignore_index=True).assign(trial=np.repeat(np.arange(102), 3)))
     # 102 trials, nominal 0.9: the central 95% binomial band is 0.843-0.951
     assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
+
+
+def test_hpd_mass_of_a_known_gaussian():
+    # 200,000 draws of a 2-d standard normal; a truth on the circle holding 90% of the mass
+    rng = np.random.default_rng(3)
+    draws = rng.normal(size=(200_000, 2))
+    radius_sq = stats.chi2(2).ppf(0.9)
+    mass = hpd_mass(-0.5 * np.sum(draws**2, axis=1), -0.5 * radius_sq)
+    assert mass == pytest.approx(0.9, abs=0.003)
+    assert hpd_mass(-0.5 * np.sum(draws**2, axis=1), 0.0) == 0.0          # the mode: nothing is denser
+
+
+def test_log_density_adds_the_gamma_prior_of_lambda_y():
+    assert log_density(-3.0, 1.0) == pytest.approx(-3.0 + stats.gamma(5, scale=0.2).logpdf(1.0))
+
+
+def test_joint_coverage_of_uniform_and_of_too_narrow_masses():
+    # calibrated: the masses are uniform; too narrow posteriors put the truths in the outer shells
+    rng = np.random.default_rng(5)
+    uniform = pd.DataFrame({"trial": np.repeat(np.arange(400), 2), "truth_hpd_mass": np.repeat(rng.uniform(size=400), 2)})
+    good = joint_coverage(uniform)
+    assert good["trials"] == 400 and good["band_low"] <= good["coverage90"] <= good["band_high"]
+    assert good["uniform_ks_p"] > 0.01
+    narrow = uniform.assign(truth_hpd_mass=uniform["truth_hpd_mass"] ** 0.5)
+    bad = joint_coverage(narrow)
+    assert bad["coverage90"] < bad["band_low"] and bad["uniform_ks_p"] < 1e-6
 
 
 def test_synthetic_truth_in_batches_equals_one_run(three_toy_trials):

@@ -257,7 +257,8 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     among the usable ones (`HydroTruths`). Observation noise of sd = sd_fraction / sqrt(lambda_y) of
     each feature is added and the features are calibrated with `settings` (the sampler reseeded from
     the trial's stream). Columns:
-    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS).
+    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS),
+    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows).
     """
     trial_ids = range(trials) if isinstance(trials, int) else trials
     names = emulator.required_inputs(shots)
@@ -276,14 +277,31 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
         lam, y = _noisy_features(eta, sd_fraction, rng, trial)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
         trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
-        _, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
+        draws, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
         summary = summary.set_index("parameter")
+        truth_ll = Problem.build(emulator, shots, observed, sd_fraction).log_likelihood(np.append(theta, lam)[None])[0]
+        mass = hpd_mass(log_density(draws["log_likelihood"], draws["lambda_y"]), log_density(truth_ll, lam))
         for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
             q05, q95 = summary.loc[name, ["q05", "q95"]]
             rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"]})
+                         "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
+                         "truth_hpd_mass": mass})
         log.info("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))
     return pd.DataFrame(rows)
+
+
+def log_density(log_likelihood, lambda_y):
+    """Log posterior density of (theta, lambda_y) up to a constant: the log-likelihood plus lambda_y's
+    Gamma prior (theta's prior is uniform on the box)."""
+    shape, rate = LAMBDA_Y_PRIOR
+    return np.asarray(log_likelihood) + stats.gamma.logpdf(lambda_y, shape, scale=1.0 / rate)
+
+
+def hpd_mass(draw_log_density, truth_log_density: float) -> float:
+    """Share of equal-weight posterior draws denser than the truth: the mass of the smallest credible
+    region that holds it. Uniform on [0, 1] when the truths come from the prior and the posterior is
+    right, whatever its shape; unlike the per-parameter intervals, one joint number per trial."""
+    return float(np.mean(np.asarray(draw_log_density) > truth_log_density))
 
 
 def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
@@ -348,6 +366,17 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     table["band_high"] = stats.binom.ppf(0.975, table["trials"], 0.9) / table["trials"]
     table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
     return table
+
+
+def joint_coverage(trials: pd.DataFrame) -> dict:
+    """The joint check from the trials' `truth_hpd_mass`: the share of trials whose truth lies in the
+    90% highest-density region, its central 95% binomial band, and the Kolmogorov-Smirnov p-value of
+    the masses against the uniform distribution they follow for a calibrated method."""
+    mass = trials.groupby("trial")["truth_hpd_mass"].first().to_numpy()
+    n = len(mass)
+    return {"trials": n, "coverage90": float(np.mean(mass <= 0.9)),
+            "band_low": stats.binom.ppf(0.025, n, 0.9) / n, "band_high": stats.binom.ppf(0.975, n, 0.9) / n,
+            "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}
 
 
 def coverage_check(emulator, shots, config: dict, trials: int | range | None = None,

@@ -82,7 +82,7 @@ def run_check(args) -> int:
                                      trials=trial_range(args.trial_range) or args.trials, truths=truths)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
-    log_coverage(coverage)
+    log_coverage(coverage, table)
     return 0
 
 
@@ -92,15 +92,24 @@ def run_coverage(args) -> int:
 
     table = read_tables(args.trials, ["trial", "parameter"], "per-trial")
     write_table(table, args.out, {"table": "synthetic-truth coverage", "batches": args.trials})
-    log_coverage(coverage_table(table))
+    log_coverage(coverage_table(table), table)
     return 0
 
 
-def log_coverage(coverage) -> None:
+def log_coverage(coverage, trials) -> None:
+    """Log the per-parameter coverage and, when the trials carry it, the joint check (`joint_coverage`)."""
     import logging
 
-    logging.getLogger("shockcal.calibrate").info("coverage of nominal 90%% intervals:\n%s",
-                                                  coverage.to_string(index=False, float_format="%.3f"))
+    from shockcal.calibration import joint_coverage
+
+    log = logging.getLogger("shockcal.calibrate")
+    log.info("coverage of nominal 90%% intervals:\n%s", coverage.to_string(index=False, float_format="%.3f"))
+    if "truth_hpd_mass" in trials and trials["truth_hpd_mass"].notna().all():
+        log.info("joint: truth in the 90%% highest-density region in %(coverage90).3f of %(trials)d trials "
+                 "(band %(band_low).3f-%(band_high).3f); masses against uniform: KS p = %(uniform_ks_p).3g",
+                 joint_coverage(trials))
+    else:
+        log.info("joint check: not available (trials from before the truth_hpd_mass column)")
 
 
 def trial_range(text: str | None) -> range | None:
