@@ -31,24 +31,23 @@ CFL_NUMBERS = (0.5, 0.25)
 WINDOW_US = (1.0, 2.1)     # the 106S analysis window of these runs (arrival about 1.0 us)
 
 
-def trace(C: float, cfl: float, velocity: float, inputs) -> np.ndarray:
+def run(C: float, cfl: float, velocity: float, inputs):
     geometry, material, settings = inputs
     params = ShotParameters(0.008397, 0.008210, C, 0.458981, 2.26, velocity, 0.30)
-    return run_shot(params, geometry, material, dataclasses.replace(settings, cfl=cfl)).v_m_s
+    return run_shot(params, geometry, material, dataclasses.replace(settings, cfl=cfl))
 
 
 def main() -> None:
     config = load_config(CONFIG)
     inputs = hydro_inputs(config, shot_config(config, SHOT))
-    t = np.arange(int(round(inputs[0].end_us / 0.0005)) + 1) * 0.0005
-    inside = (t > WINDOW_US[0]) & (t < WINDOW_US[1])
     print(f"load average at start: {os.getloadavg()[0]:.2f}")
     print(f"{'C':>8}{'CFL':>6}   |dv| from a 1e-12 velocity change: median / max (m/s)   CFL halved: median / max")
     for C in RATE_COEFFICIENTS:
         for cfl in CFL_NUMBERS:
-            base = trace(C, cfl, VELOCITY_CM_US, inputs)
-            moved = np.abs(trace(C, cfl, VELOCITY_CM_US * (1 + PERTURBATION), inputs) - base)[inside]
-            halved = np.abs(trace(C, cfl / 2, VELOCITY_CM_US, inputs) - base)[inside]
+            base = run(C, cfl, VELOCITY_CM_US, inputs)
+            inside = (base.t_us > WINDOW_US[0]) & (base.t_us < WINDOW_US[1])
+            moved = np.abs(run(C, cfl, VELOCITY_CM_US * (1 + PERTURBATION), inputs).v_m_s - base.v_m_s)[inside]
+            halved = np.abs(run(C, cfl / 2, VELOCITY_CM_US, inputs).v_m_s - base.v_m_s)[inside]
             print(f"{C:8.4f}{cfl:6.2f}   {np.median(moved):12.2e} / {moved.max():.2e}"
                   f"{'':30}{np.median(halved):.2e} / {halved.max():.2e}")
 

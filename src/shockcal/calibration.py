@@ -362,8 +362,7 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     band, and the smallest Kish ESS of any trial."""
     table = trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
                                                         min_ess=("ess", "min")).reset_index()
-    table["band_low"] = stats.binom.ppf(0.025, table["trials"], 0.9) / table["trials"]
-    table["band_high"] = stats.binom.ppf(0.975, table["trials"], 0.9) / table["trials"]
+    table["band_low"], table["band_high"] = binomial_band(table["trials"])
     table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
     return table
 
@@ -373,10 +372,15 @@ def joint_coverage(trials: pd.DataFrame) -> dict:
     90% highest-density region, its central 95% binomial band, and the Kolmogorov-Smirnov p-value of
     the masses against the uniform distribution they follow for a calibrated method."""
     mass = trials.groupby("trial")["truth_hpd_mass"].first().to_numpy()
-    n = len(mass)
-    return {"trials": n, "coverage90": float(np.mean(mass <= 0.9)),
-            "band_low": stats.binom.ppf(0.025, n, 0.9) / n, "band_high": stats.binom.ppf(0.975, n, 0.9) / n,
-            "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}
+    band_low, band_high = binomial_band(len(mass))
+    return {"trials": len(mass), "coverage90": float(np.mean(mass <= 0.9)), "band_low": band_low,
+            "band_high": band_high, "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}
+
+
+def binomial_band(trials):
+    """The central 95% band of the share of `trials` (a count or an array of counts) that a
+    calibrated 90% interval covers."""
+    return stats.binom.ppf(0.025, trials, 0.9) / trials, stats.binom.ppf(0.975, trials, 0.9) / trials
 
 
 def coverage_check(emulator, shots, config: dict, trials: int | range | None = None,
