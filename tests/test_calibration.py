@@ -130,6 +130,15 @@ def test_calibrate_returns_draws_summary_and_evidence(paper_config):
     assert info["parameters"] == ["A"] and np.isfinite(info["log_evidence"]) and info["likelihood_evaluations"] > 800
 
 
+def test_cube_power_of_an_input_not_calibrated_is_an_error_naming_it():
+    emulator = StandInEmulator(lambda t: np.column_stack([100 + 10 * t[:, 0], 80 + 0 * t[:, 0]]), ["a"], [0], [1],
+                               np.eye(2))
+    problem = Problem.build(emulator, ["S"], _observed([105.0, 80.0]), 0.01)
+    np.testing.assert_array_equal(problem.cube_power({"a": 2.0}), [2.0, 1.0])
+    with pytest.raises(InputError, match=r"cube_power names \['m'\], not among the calibrated inputs \['a'\]"):
+        problem.cube_power({"m": 2.0})
+
+
 def test_non_finite_likelihood_is_an_error_naming_the_point():
     def broken(t):
         mean = np.column_stack([100 + 10 * t[:, 0], 80 + 0 * t[:, 0]])

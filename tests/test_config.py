@@ -40,6 +40,8 @@ def test_paper_config_is_valid(paper_config):
         ("observed.records", {"104S": {"path": "no/such/record.txt"}},
          r"observed\.records\.104S\.path: no/such/record\.txt does not exist"),
         ("design.file", "no/such/design.csv", r"design\.file: no/such/design\.csv does not exist"),
+        ("calibration.cube_power", {"M": 2}, r"calibration\.cube_power\.M: not one of the inputs"),
+        ("calibration.cube_power", {"m": 0.5}, r"calibration\.cube_power\.m: 0\.5 is less than the minimum of 1"),
     ],
 )
 def test_bad_values_name_key_and_reason(paper_config, path, value, message):

@@ -76,6 +76,15 @@ class Problem:
         theta = self.lower + u[:, :-1] * (self.upper - self.lower)
         return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
 
+    def cube_power(self, powers: Mapping[str, float]) -> np.ndarray:
+        """`nested_sample`'s per-coordinate unit-cube power from powers of named inputs (1 for the
+        others and lambda_y); a name this problem does not calibrate is an error."""
+        unknown = sorted(set(powers) - set(self.names))
+        if unknown:
+            raise InputError(f"{self.label}: calibration.cube_power names {unknown}, not among the calibrated "
+                             f"inputs {self.names}")
+        return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0])
+
     def log_likelihood(self, points: np.ndarray) -> np.ndarray:
         """Gaussian log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
         inside the box, normalising constants included (so the evidence is a true marginal likelihood).
@@ -139,12 +148,14 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
 @dataclass(frozen=True)
 class SamplerSettings:
     """nautilus: live points, the effective sample size (Kish) to reach, the number of equal-weight
-    draws written, and the seed."""
+    draws written, the seed, and the unit-cube power of named inputs (`nested_sample`'s
+    `cube_power`: where the sampler looks, not the posterior)."""
 
     n_live: int = 1000
     n_eff: int = 3000
     draws: int = 10000
     seed: int = 0
+    cube_power: Mapping[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -161,12 +172,13 @@ class CalibrationSettings:
     @classmethod
     def from_config(cls, config: dict, shots, check: bool = False) -> CalibrationSettings:
         """The adapter from a validated config: `calibration` (with `check`, the synthetic-truth
-        trials' `calibration.check`, whose draws are its n_eff), seeded by the shots' "calibration"
-        stream of study.seed (a trial reseeds from its own stream)."""
+        trials' `calibration.check`, whose draws are its n_eff; `calibration.cube_power` for both),
+        seeded by the shots' "calibration" stream of study.seed (a trial reseeds from its own stream)."""
         section = config["calibration"]["check"] if check else config["calibration"]
         draws = section["n_eff"] if check else section["draws"]
         seed = stream_seed(config["study"]["seed"], "calibration", *shots)
-        return cls(SamplerSettings(section["n_live"], section["n_eff"], draws, seed),
+        sampler = SamplerSettings(section["n_live"], section["n_eff"], draws, seed, config["calibration"]["cube_power"])
+        return cls(sampler,
                    config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                    {name: box["unit"] for name, box in config["inputs"].items()})
 
@@ -180,13 +192,14 @@ def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, p
     weighted ones, the summary of the weighted draws, and run info (evidence, likelihood
     evaluations, Kish ESS, distinct draws)."""
     weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
-                             settings.n_eff, settings.seed)
+                             settings.n_eff, settings.seed, problem.cube_power(settings.cube_power))
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     frame = pd.DataFrame(weighted.points[rows], columns=[*problem.names, "lambda_y"])
     frame["log_likelihood"] = weighted.log_likelihood[rows]
     info = {"sampler": "nautilus", "n_live": settings.n_live, "n_eff_target": settings.n_eff, "seed": settings.seed,
             "log_evidence": weighted.log_evidence, "likelihood_evaluations": weighted.n_likelihood,
-            "weighted_draws": len(weighted.points), "ess_kish": weighted.kish_ess(), "retained": len(frame),
+            "cube_power": dict(settings.cube_power), "weighted_draws": len(weighted.points),
+            "ess_kish": weighted.kish_ess(), "retained": len(frame),
             "distinct_draws": int(len(np.unique(rows)))}
     return frame, summarize(weighted, [*problem.names, "lambda_y"]), info
 
@@ -238,7 +251,8 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     `observed` (one row per shot, m/s and us; `source` names it in errors): samples, summary, run info."""
     problem = Problem.build(emulator, shots, observed, settings.sd_fraction, source)
     check_observed_table(observed, shots, source, settings.check_units)
-    samples, summary, info = sample(problem, settings.sampler)
+    powers = {k: v for k, v in settings.sampler.cube_power.items() if k in problem.names}  # e.g. no Delta2 for 104S
+    samples, summary, info = sample(problem, replace(settings.sampler, cube_power=powers))
     units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
     summary.insert(1, "unit", summary["parameter"].map(units))
     info.update(shots=list(shots), parameters=problem.names, units=units,

@@ -96,8 +96,8 @@ def _schema_message(exc) -> str:
 
 
 def check_semantics(config: dict, source: str = "config") -> None:
-    """Rules beyond the schema: box bounds ordered, shot mappings name real inputs, files exist, the design
-    file's contents pass `load_design`, observed features look like m/s and us (shockcal.plausibility)."""
+    """Rules beyond the schema: box bounds ordered, shot mappings and sampler powers name real inputs, files
+    exist, the design file's contents pass `load_design`, observed features look like m/s and us (shockcal.plausibility)."""
     inputs = config["inputs"]
     for name, box in inputs.items():
         if not box["min"] < box["max"]:
@@ -113,6 +113,9 @@ def check_semantics(config: dict, source: str = "config") -> None:
         for key, name in mapped:
             if name not in inputs:
                 raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
+    for name in config["calibration"]["cube_power"]:
+        if name not in inputs:
+            raise ConfigError(f"{source}: calibration.cube_power.{name}: not one of the inputs {sorted(inputs)}")
     design_file = config["design"].get("file")
     if design_file and not Path(design_file).is_file():
         raise ConfigError(f"{source}: design.file: {design_file} does not exist")

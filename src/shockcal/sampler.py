@@ -50,7 +50,8 @@ class WeightedDraws:
         return np.searchsorted(edges, (rng.uniform() + np.arange(n)) / n)
 
 
-def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff: int, seed: int) -> WeightedDraws:
+def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff: int, seed: int,
+                  cube_power=None) -> WeightedDraws:
     """Run nautilus until the weighted draws reach `n_eff` effective (Kish) samples.
 
     `prior_transform` maps (N, ndim) points of the unit cube to parameters; `log_likelihood` takes
@@ -58,12 +59,32 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     problem one gives the same posterior at a quarter of the training time). The exploration
     phase is discarded, as nautilus advises for an unbiased posterior and evidence. Same seed,
     same draws.
+
+    `cube_power` (ndim,), default all 1, changes where the sampler looks, not the posterior: unit
+    coordinate j is drawn as v_j = u_j^p_j before the prior transform, and the likelihood nautilus
+    sees is multiplied by the prior-to-sampling density ratio prod_j p_j u_j^(p_j - 1), so the
+    weighted draws and the evidence target the same posterior. A power above 1 widens the low end
+    of a coordinate in the cube: a thin posterior arm there (m near 0, docs/calibration.md "The
+    low-m arm") gets as many live points as its mass needs instead of being cut off by the bounds.
+    The draws' `log_likelihood` is the caller's, without the ratio.
     """
     from nautilus import Sampler
 
-    sampler = Sampler(prior_transform, log_likelihood, n_dim=ndim, n_live=n_live, vectorized=True, seed=seed,
+    power = np.ones(ndim) if cube_power is None else np.asarray(cube_power, dtype=float)
+    warped = np.flatnonzero(power != 1.0)
+
+    def log_density_ratio(u):
+        return np.sum(np.log(power[warped]) + (power[warped] - 1.0) * np.log(u[:, warped]), axis=1)
+
+    def to_parameters(u):
+        return prior_transform(u ** power)
+
+    def sampled_log_likelihood(u):
+        return log_likelihood(to_parameters(u)) + log_density_ratio(u)
+
+    sampler = Sampler(lambda u: u, sampled_log_likelihood, n_dim=ndim, n_live=n_live, vectorized=True, seed=seed,
                       n_networks=1)
     sampler.run(n_eff=n_eff, discard_exploration=True, verbose=False)
-    points, log_w, log_l = sampler.posterior()
-    return WeightedDraws(np.asarray(points), log_w - logsumexp(log_w), np.asarray(log_l), float(sampler.log_z),
-                         int(sampler.n_like))
+    cube, log_w, log_l = (np.asarray(a) for a in sampler.posterior())
+    return WeightedDraws(to_parameters(cube), log_w - logsumexp(log_w), log_l - log_density_ratio(cube),
+                         float(sampler.log_z), int(sampler.n_like))
