@@ -98,7 +98,7 @@ def run_default(problem, settings, seed):
 
     start, cpu = time.perf_counter(), time.process_time()
     draws = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings["n_live"],
-                          settings["n_eff"], seed)
+                          settings["n_eff"], seed, problem.cube_power(settings["cube_power"], others="ignore"))
     points = draws.points[draws.resample(20000, np.random.default_rng(seed))]
     return points, time.perf_counter() - start, time.process_time() - cpu, draws.n_likelihood, draws
 
@@ -232,7 +232,7 @@ def main(argv=None) -> int:
     observed = read_table(args.observed)
     settings = config["calibration"]
     print(f"emulator {args.emulator}, observed {args.observed}; nautilus {settings['n_live']} live points, "
-          f"ESS {settings['n_eff']}")
+          f"ESS {settings['n_eff']}, cube powers {settings['cube_power']}")
     for name in args.only:
         shots = SHOTS if name == "joint" else [name]
         problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"])

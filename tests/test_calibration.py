@@ -137,6 +137,7 @@ def test_cube_power_of_an_input_not_calibrated_is_an_error_naming_it():
     np.testing.assert_array_equal(problem.cube_power({"a": 2.0}), [2.0, 1.0])
     with pytest.raises(InputError, match=r"cube_power names \['m'\], not among the calibrated inputs \['a'\]"):
         problem.cube_power({"m": 2.0})
+    np.testing.assert_array_equal(problem.cube_power({"m": 2.0, "a": 3.0}, others="ignore"), [3.0, 1.0])
 
 
 def test_non_finite_likelihood_is_an_error_naming_the_point():

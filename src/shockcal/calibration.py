@@ -76,11 +76,12 @@ class Problem:
         theta = self.lower + u[:, :-1] * (self.upper - self.lower)
         return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
 
-    def cube_power(self, powers: Mapping[str, float]) -> np.ndarray:
+    def cube_power(self, powers: Mapping[str, float], others: str = "error") -> np.ndarray:
         """`nested_sample`'s per-coordinate unit-cube power from powers of named inputs (1 for the
-        others and lambda_y); a name this problem does not calibrate is an error."""
+        others and lambda_y). A name this problem does not calibrate is an error, or with
+        `others="ignore"` skipped (a study's powers in a single-shot calibration: 104S has no Delta2)."""
         unknown = sorted(set(powers) - set(self.names))
-        if unknown:
+        if unknown and others != "ignore":
             raise InputError(f"{self.label}: calibration.cube_power names {unknown}, not among the calibrated "
                              f"inputs {self.names}")
         return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0])
@@ -187,18 +188,20 @@ class CalibrationSettings:
         return replace(self, sampler=replace(self.sampler, **changes))
 
 
-def sample(problem: Problem, settings: SamplerSettings) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+def sample(problem: Problem, settings: SamplerSettings, other_powers: str = "error"
+           ) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Sample the posterior: equal-weight draws (theta, lambda_y, log_likelihood) resampled from the
     weighted ones, the summary of the weighted draws, and run info (evidence, likelihood
-    evaluations, Kish ESS, distinct draws)."""
+    evaluations, Kish ESS, distinct draws). `other_powers`: `Problem.cube_power`'s `others`."""
+    power = problem.cube_power(settings.cube_power, other_powers)
     weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
-                             settings.n_eff, settings.seed, problem.cube_power(settings.cube_power))
+                             settings.n_eff, settings.seed, power)
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     frame = pd.DataFrame(weighted.points[rows], columns=[*problem.names, "lambda_y"])
     frame["log_likelihood"] = weighted.log_likelihood[rows]
     info = {"sampler": "nautilus", "n_live": settings.n_live, "n_eff_target": settings.n_eff, "seed": settings.seed,
             "log_evidence": weighted.log_evidence, "likelihood_evaluations": weighted.n_likelihood,
-            "cube_power": dict(settings.cube_power), "weighted_draws": len(weighted.points),
+            "cube_power": {k: p for k, p in zip(problem.names, power) if p != 1.0}, "weighted_draws": len(weighted.points),
             "ess_kish": weighted.kish_ess(), "retained": len(frame),
             "distinct_draws": int(len(np.unique(rows)))}
     return frame, summarize(weighted, [*problem.names, "lambda_y"]), info
@@ -251,8 +254,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     `observed` (one row per shot, m/s and us; `source` names it in errors): samples, summary, run info."""
     problem = Problem.build(emulator, shots, observed, settings.sd_fraction, source)
     check_observed_table(observed, shots, source, settings.check_units)
-    powers = {k: v for k, v in settings.sampler.cube_power.items() if k in problem.names}  # e.g. no Delta2 for 104S
-    samples, summary, info = sample(problem, replace(settings.sampler, cube_power=powers))
+    samples, summary, info = sample(problem, settings.sampler, other_powers="ignore")
     units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
     summary.insert(1, "unit", summary["parameter"].map(units))
     info.update(shots=list(shots), parameters=problem.names, units=units,
