@@ -179,8 +179,7 @@ class CalibrationSettings:
         draws = section["n_eff"] if check else section["draws"]
         seed = stream_seed(config["study"]["seed"], "calibration", *shots)
         sampler = SamplerSettings(section["n_live"], section["n_eff"], draws, seed, config["calibration"]["cube_power"])
-        return cls(sampler,
-                   config["observed"]["sd_fraction"], config["checks"]["observed_units"],
+        return cls(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                    {name: box["unit"] for name, box in config["inputs"].items()})
 
     def with_sampler(self, **changes) -> CalibrationSettings:
@@ -201,8 +200,8 @@ def sample(problem: Problem, settings: SamplerSettings, other_powers: str = "err
     frame["log_likelihood"] = weighted.log_likelihood[rows]
     info = {"sampler": "nautilus", "n_live": settings.n_live, "n_eff_target": settings.n_eff, "seed": settings.seed,
             "log_evidence": weighted.log_evidence, "likelihood_evaluations": weighted.n_likelihood,
-            "cube_power": {k: p for k, p in zip(problem.names, power) if p != 1.0}, "weighted_draws": len(weighted.points),
-            "ess_kish": weighted.kish_ess(), "retained": len(frame),
+            "cube_power": {k: float(p) for k, p in zip(problem.names, power) if p != 1.0},
+            "weighted_draws": len(weighted.points), "ess_kish": weighted.kish_ess(), "retained": len(frame),
             "distinct_draws": int(len(np.unique(rows)))}
     return frame, summarize(weighted, [*problem.names, "lambda_y"]), info
 
