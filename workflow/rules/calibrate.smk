@@ -60,7 +60,9 @@ rule calibration_check_batch:
         batch=r"\d+",
     conda:
         "../envs/shockcal.yaml"
-    threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
+    # one core per batch, so batches run side by side: a batch keeps only 1.2 cores busy (nautilus's
+    # network training is serial), and two at a time on 2 cores give 1.7x the trials per hour (docs/calibration.md)
+    threads: 1
     params:
         settings=stage_config(config, "calibrate_check"),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
