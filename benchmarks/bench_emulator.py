@@ -5,7 +5,7 @@ features (runs 0-499, real data), fit + K-fold + outer-check wall time and the R
 of each scheme; fit + K-fold on 1000 runs (the paper's design with a smooth synthetic 12-feature
 response, since FLAG features exist only for 500 runs); the time to predict mean and covariance of
 all 12 features at 1000 inputs on one and two threads; the same on our own runs when
-`results/features` holds them.
+`results/training/features` holds them.
 """
 
 from __future__ import annotations
@@ -69,10 +69,10 @@ def main() -> None:
     time_prediction(emulator, inputs)
     print("1000 runs x 12 features (synthetic response):")
     fit_and_kfold(config, design, synthetic_features(design, config), inputs)
-    own = REPO / "results" / "features"
+    own = REPO / "results" / "training" / "features"
     if all((own / f"{s}.parquet").is_file() for s in SHOTS):
         print(f"our own runs ({own}):")
-        fit_and_kfold(config, pd.read_parquet(REPO / "results" / "design.parquet"),
+        fit_and_kfold(config, pd.read_parquet(REPO / "results" / "training" / "design.parquet"),
                       {s: pd.read_parquet(own / f"{s}.parquet") for s in SHOTS}, inputs)
 
 

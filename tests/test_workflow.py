@@ -8,6 +8,7 @@ directory and shared by the tests of this module; the rerun checks are dry runs 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -47,18 +48,21 @@ def overlay(path: Path, **sections) -> Path:
 
 
 def pending_jobs(*config_files, target="all") -> dict[str, int]:
-    """Rule -> number of jobs a dry run of `target` would execute (empty when nothing is to be done)."""
+    """Rule -> number of jobs a dry run of `target` would execute (empty when nothing is to be done).
+    Jobs of the run-set rules count under the rule's name for the training runs and under
+    "rule[run set]" for the others ("simulate[predict]"), so a rerun of training runs stays visible."""
     out = snakemake(target, "--dry-run", config_files=config_files).stdout
     if "Job stats:" not in out:
         assert "Nothing to be done" in out, out[-2000:]
         return {}
-    table = out.split("Job stats:")[1].splitlines()
     jobs = {}
-    for line in table[3:]:
-        name, _, count = line.rpartition(" ")
-        if name.strip() == "total":
-            break
-        jobs[name.strip()] = int(count)
+    for block in re.split(r"^(?=(?:local)?rule \S+:$)", out, flags=re.MULTILINE)[1:]:
+        rule = re.match(r"(?:local)?rule (\S+):", block).group(1)
+        run_set = re.search(r"^\s+wildcards:.*\brun_set=(\w+)", block, flags=re.MULTILINE)
+        key = rule if run_set is None or run_set.group(1) == "training" else f"{rule}[{run_set.group(1)}]"
+        jobs[key] = jobs.get(key, 0) + 1
+    total = int(re.search(r"^total\s+(\d+)$", out, flags=re.MULTILINE).group(1))
+    assert sum(jobs.values()) == total, (jobs, out[-2000:])
     return jobs
 
 
@@ -89,7 +93,7 @@ def test_study_products(study):
     results, _ = study
     usable = None
     for shot in ("104S", "105S", "106S"):
-        features = pd.read_parquet(results / "features" / f"{shot}.parquet")
+        features = pd.read_parquet(results / "training" / "features" / f"{shot}.parquet")
         assert len(features) == 40 and (features["status"] == "ok").mean() >= 0.95
         ok = set(features.loc[features["status"] == "ok", "run"])
         usable = ok if usable is None else usable & ok
@@ -126,7 +130,7 @@ def test_physics_setting_reruns_every_simulation(study, tmp_path):
 
 def test_added_design_rows_run_only_new_chunks(study, tmp_path):
     results, config = study
-    design = pd.read_parquet(results / "design.parquet")
+    design = pd.read_parquet(results / "training" / "design.parquet")
     extra = design.tail(10).copy()
     extra["run"] += 10
     extra["A"] *= 0.9
@@ -160,7 +164,7 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
     its rule did not list it). The design is fixed by a file so that only the seed differs."""
     results, config = study
     design = tmp_path / "design.parquet"
-    shutil.copy(results / "design.parquet", design)
+    shutil.copy(results / "training" / "design.parquet", design)
     fixed = overlay(tmp_path / "fixed.yaml", design={"file": str(design)})
     reseeded = overlay(tmp_path / "seed.yaml", study={"seed": 7})
     flagged = params_changed(config, fixed, reseeded) - params_changed(config, fixed)
@@ -189,8 +193,8 @@ def test_deleted_intermediates_rerun_only_their_dependents(study):
     """A deleted simulation chunk reruns that chunk, its features and what depends on them; a deleted
     features table reruns its shot's merge and what follows, and no simulation or extraction."""
     results, config = study
-    chunk = results / "simulations" / "104S" / "chunk-1.parquet"
-    features = results / "features" / "105S.parquet"
+    chunk = results / "training" / "simulations" / "104S" / "chunk-1.parquet"
+    features = results / "training" / "features" / "105S.parquet"
     kept = {path: path.with_name(path.name + ".kept") for path in (chunk, features)}
     for path, aside in kept.items():
         path.rename(aside)
@@ -209,7 +213,7 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
     a design file) and its record. Only its chunks are simulated; the other shots' are untouched."""
     results, config = study
     quick = load_config(REPO / "config" / "config.yaml")
-    design = pd.read_parquet(results / "design.parquet")
+    design = pd.read_parquet(results / "training" / "design.parquet")
     box = quick["inputs"]["V3"]
     design["V4"] = np.random.default_rng(1).uniform(box["min"], box["max"], len(design))
     grown = tmp_path / "design.parquet"
@@ -273,7 +277,7 @@ def test_a_second_snakemake_on_the_directory_is_refused(tmp_path):
     config = overlay(tmp_path / "locked.yaml", study={"results_dir": str(tmp_path / "results")})
     first = snakemake("all", "--cores", "1", config_files=[config], start_new_session=True)
     deadline = time.monotonic() + 120
-    while not list((tmp_path / "results").glob("simulations/*/chunk-*.parquet")) and time.monotonic() < deadline:
+    while not list((tmp_path / "results").glob("training/simulations/*/chunk-*.parquet")) and time.monotonic() < deadline:
         time.sleep(0.1)
     try:
         second = snakemake("all", "--cores", "1", config_files=[config], check=False)
@@ -294,8 +298,8 @@ def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path, si
     results, _ = study
     resumed = tmp_path / "results"
     config = overlay(tmp_path / "resumed.yaml", study={"results_dir": str(resumed)})
-    target = resumed / "features" / "104S.parquet"
-    chunks = resumed / "simulations" / "104S"
+    target = resumed / "training" / "features" / "104S.parquet"
+    chunks = resumed / "training" / "simulations" / "104S"
     run = snakemake(str(target), "--cores", "1", config_files=[config], start_new_session=True)
     deadline = time.monotonic() + 120
     while not any(chunks.glob("chunk-*.parquet")) and time.monotonic() < deadline and run.poll() is None:
@@ -316,7 +320,7 @@ def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path, si
     assert not list(chunks.glob(".*tmp*")), "temporaries left behind"
     for k in range(4):
         ours = pd.read_parquet(chunks / f"chunk-{k}.parquet").drop(columns="wall_time_s")
-        reference = pd.read_parquet(results / "simulations" / "104S" / f"chunk-{k}.parquet").drop(columns="wall_time_s")
+        reference = pd.read_parquet(results / "training" / "simulations" / "104S" / f"chunk-{k}.parquet").drop(columns="wall_time_s")
         pd.testing.assert_frame_equal(ours, reference, check_exact=True)
-    pd.testing.assert_frame_equal(pd.read_parquet(target), pd.read_parquet(results / "features" / "104S.parquet"),
+    pd.testing.assert_frame_equal(pd.read_parquet(target), pd.read_parquet(results / "training" / "features" / "104S.parquet"),
                                   check_exact=True)

@@ -189,6 +189,12 @@ def job_stats(text: str) -> dict[str, int]:
     return jobs
 
 
+def simulate_wildcards(comment: str) -> tuple[str, str, str]:
+    """(run set, shot, chunk) of a simulate job from its SLURM comment."""
+    run_set, shot, chunk = comment.removeprefix("rule_simulate_wildcards_").split("_")
+    return run_set, shot, chunk
+
+
 def cancel_running_simulate(run: Run, squeue: Squeue, results: Path, exclude: set[str], wait_for_log: bool,
                             comment: str | None = None, timeout: float = 600) -> tuple[str, str, float]:
     """scancel the first simulate job seen RUNNING (with its shockcal log written when wait_for_log;
@@ -203,8 +209,8 @@ def cancel_running_simulate(run: Run, squeue: Squeue, results: Path, exclude: se
                 continue
             if comment is not None and job["comment"] != comment:
                 continue
-            shot, chunk = job["comment"].removeprefix("rule_simulate_wildcards_").rsplit("_", 1)
-            if wait_for_log and not (results / "logs" / "simulate" / shot / f"chunk-{chunk}.log").exists():
+            run_set, shot, chunk = simulate_wildcards(job["comment"])
+            if wait_for_log and not (results / "logs" / run_set / "simulate" / shot / f"chunk-{chunk}.log").exists():
                 continue
             subprocess.run(["scancel", job["id"]], check=True)
             t = time.time()
@@ -287,12 +293,13 @@ def benchmark_file(results: Path, comment: str) -> Path | None:
     rule, wildcards = m.group(1), (m.group(2) or "").split("_") if m.group(2) else []
     bench = results / "benchmarks"
     candidates = {
-        "simulate": lambda: bench / "simulate" / wildcards[0] / f"chunk-{wildcards[1]}.tsv",
-        "features_chunk": lambda: bench / "features" / wildcards[0] / f"chunk-{wildcards[1]}.tsv",
-        "features": lambda: bench / "features" / f"{wildcards[0]}.tsv",
+        "simulate": lambda: bench / wildcards[0] / "simulate" / wildcards[1] / f"chunk-{wildcards[2]}.tsv",
+        "features_chunk": lambda: bench / wildcards[0] / "features" / wildcards[1] / f"chunk-{wildcards[2]}.tsv",
+        "features": lambda: bench / wildcards[0] / "features" / f"{wildcards[1]}.tsv",
         "calibrate": lambda: bench / "calibrate" / f"{wildcards[0]}.tsv",
         "emulator": lambda: bench / "emulator.tsv",
-        "design": lambda: bench / "design.tsv",
+        "check_design": lambda: bench / "check" / "design.tsv",
+        "predict_design": lambda: bench / "predict" / "design.tsv",
     }
     if rule in candidates:
         path = candidates[rule]()
@@ -343,7 +350,7 @@ def main() -> int:
     log("SLURM run 1 (cancels one simulate job and its retry) ...")
     run1 = Run(snakemake_args(config, *extra), work / "slurm-run1.log")
     first_id, comment, t_cancel1 = cancel_running_simulate(run1, squeue, results, set(), wait_for_log=True)
-    shot, chunk = comment.removeprefix("rule_simulate_wildcards_").rsplit("_", 1)
+    run_set, shot, chunk = simulate_wildcards(comment)
     t_retry = None
     deadline = time.time() + DETECTION_BOUND_S
     while time.time() < deadline and t_retry is None:
@@ -367,7 +374,7 @@ def main() -> int:
                 failures.append(f"the failed retry was reported only after {t_error - t_cancel2:.0f} s")
     if rc1 == 0:
         failures.append("run 1 exited 0 although a chunk was cancelled twice")
-    chunk_file = results / "simulations" / shot / f"chunk-{chunk}.parquet"
+    chunk_file = results / run_set / "simulations" / shot / f"chunk-{chunk}.parquet"
     if chunk_file.exists():
         failures.append(f"{chunk_file} exists after its job was cancelled")
     leftovers = [p for p in chunk_file.parent.glob(f"*chunk-{chunk}*") if p != chunk_file] if chunk_file.parent.exists() else []

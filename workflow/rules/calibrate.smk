@@ -33,18 +33,34 @@ CHECK_BATCHES = list(range(chunk_count(CHECK["trials"], CHECK["trials_per_job"])
 CHECK_TRUTHS = ["emulator", "hydrocode"]
 
 
+rule check_design:
+    """The hydrocode-truth check's truths: a Latin hypercube over the box (run set "check")."""
+    output:
+        run_set_path("check", "design.parquet"),
+    log:
+        f"{LOGS}/check/design.log",
+    benchmark:
+        f"{BENCHMARKS}/check/design.tsv"
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(config, "check_design"),
+    shell:
+        "shockcal design --stream check_design --out {output} > {log} 2>&1"
+
+
 rule calibration_check_batch:
     """One batch of synthetic-truth trials (each trial has its own random stream, so batches are
     independent jobs and together give what one run of every trial gives)."""
     input:
-        # hydrocode truth also reads the check design and its runs' features (predict.smk's run set "check")
+        # hydrocode truth also reads the check design and its runs' features (the run set "check")
         unpack(
             lambda w: (
                 {}
                 if w.truth == "emulator"
                 else {
                     "design": rules.check_design.output[0],
-                    "features": expand(rules.run_set_features.output[0], run_set="check", shot=SHOTS),
+                    "features": expand(rules.features.output[0], run_set="check", shot=SHOTS),
                 }
             )
         ),

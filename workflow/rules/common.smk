@@ -1,4 +1,4 @@
-# Shared helpers of the rule files: the effective config, chunking, config slices.
+# Helpers shared by every rule file (the effective config, chunking, config slices, run-set paths).
 import hashlib
 import os
 
@@ -29,3 +29,21 @@ CHUNK_SIZE = config["simulate"]["chunk_size"]
 
 LOGS = f"{RESULTS}/logs"
 BENCHMARKS = f"{RESULTS}/benchmarks"
+
+
+# Run sets (design.smk): their paths and the rules' inputs built from them.
+def run_set_path(run_set, *parts):
+    """A run set's file or directory: {RESULTS}/{run_set}/{parts...}."""
+    return "/".join([RESULTS, run_set, *parts])
+
+
+def run_set_design(wildcards):
+    """The design a run set's chunks read: the training design is planned at parse time (ancient)."""
+    if wildcards.run_set == "training":
+        return ancient(DESIGN)
+    return run_set_path(wildcards.run_set, "design.parquet")
+
+
+def simulations(run_set, shot):
+    """Every simulation chunk of one run set's shot."""
+    return expand(rules.simulate.output[0], run_set=run_set, shot=shot, chunk=RUN_SET_CHUNKS[run_set])

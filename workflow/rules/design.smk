@@ -4,7 +4,17 @@
 # job would be an `ancient` input of every chunk, and snakemake drops the jobs downstream of an
 # `ancient` input whose producer reruns in the same invocation, snakemake/snakemake#4166: appended
 # rows ran on the second call only.) `shockcal design` writes the same table outside the workflow.
-DESIGN = f"{RESULTS}/design.parquet"
+#
+# Run sets: every set of hydrocode runs goes through the same rules (simulate.smk, features.smk) and
+# the same paths, {RESULTS}/{run_set}/{design.parquet, simulations/, features/}, in chunks of
+# simulate.chunk_size design rows:
+#   training: the design below, for the emulator;
+#   predict:  predict.n_posterior_runs seeded joint-posterior draws (Figs 10-13; predict.smk);
+#   check:    calibration.check.trials truths on a Latin hypercube over the box, for the synthetic-truth
+#             check with hydrocode-made pseudo-measurements (calibrate.smk).
+
+
+DESIGN = run_set_path("training", "design.parquet")
 _PLANNED_DESIGN, _DESIGN_SOURCE = study_design(config)
 write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, config, DESIGN)
 # a digest per shot and chunk, over the run ids and the columns that shot reads: a column added for
@@ -12,4 +22,9 @@ write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, config, DESIGN)
 CHUNK_DIGESTS = {
     shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_inputs(config, shot)]], CHUNK_SIZE) for shot in SHOTS
 }
-CHUNKS = list(range(chunk_count(len(_PLANNED_DESIGN), CHUNK_SIZE)))
+RUN_SET_SIZES = {
+    "training": len(_PLANNED_DESIGN),
+    "predict": config["predict"]["n_posterior_runs"],
+    "check": config["calibration"]["check"]["trials"],
+}
+RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SET_SIZES.items()}

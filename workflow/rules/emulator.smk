@@ -6,7 +6,7 @@
 rule emulator:
     input:
         design=DESIGN,
-        features=expand(rules.features.output[0], shot=SHOTS),
+        features=expand(rules.features.output[0], run_set="training", shot=SHOTS),
     output:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",

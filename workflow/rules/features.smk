@@ -1,16 +1,18 @@
-# Features: per simulation chunk (they fan out with the simulations), merged per shot, where the
-# failed-run budget is checked; observed features from the config or records.
+# Features of every run set: per simulation chunk (they fan out with the simulations), merged per shot,
+# where the failed-run budget is checked; observed features from the config or records.
 
 
 rule features_chunk:
     input:
         rules.simulate.output[0],
     output:
-        f"{RESULTS}/features/{{shot}}/chunk-{{chunk}}.parquet",
+        f"{RESULTS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.parquet",
     log:
-        f"{LOGS}/features/{{shot}}/chunk-{{chunk}}.log",
+        f"{LOGS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
-        f"{BENCHMARKS}/features/{{shot}}/chunk-{{chunk}}.tsv"
+        f"{BENCHMARKS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.tsv"
+    wildcard_constraints:
+        run_set="|".join(RUN_SET_SIZES),
     conda:
         "../envs/shockcal.yaml"
     params:
@@ -21,13 +23,17 @@ rule features_chunk:
 
 rule features:
     input:
-        expand(rules.features_chunk.output[0], chunk=CHUNKS, allow_missing=True),
+        lambda w: expand(
+            rules.features_chunk.output[0], run_set=w.run_set, shot=w.shot, chunk=RUN_SET_CHUNKS[w.run_set]
+        ),
     output:
-        f"{RESULTS}/features/{{shot}}.parquet",
+        f"{RESULTS}/{{run_set}}/features/{{shot}}.parquet",
     log:
-        f"{LOGS}/features/{{shot}}.log",
+        f"{LOGS}/{{run_set}}/features/{{shot}}.log",
     benchmark:
-        f"{BENCHMARKS}/features/{{shot}}.tsv"
+        f"{BENCHMARKS}/{{run_set}}/features/{{shot}}.tsv"
+    wildcard_constraints:
+        run_set="|".join(RUN_SET_SIZES),
     conda:
         "../envs/shockcal.yaml"
     params:
@@ -55,5 +61,5 @@ rule observed:
         "shockcal observed --out {output} > {log} 2>&1"
 
 
-ALL_TARGETS += expand(rules.features.output[0], shot=SHOTS)
+ALL_TARGETS += expand(rules.features.output[0], run_set="training", shot=SHOTS)
 ALL_TARGETS += rules.observed.output

@@ -9,19 +9,19 @@ FIGURE_SPECS = catalogue(config)
 HISTORY_SHOTS = history_names(config)
 FIGURE_FORMATS = config["figures"]["formats"]
 REPORT_FORMAT = "png" if "png" in FIGURE_FORMATS else FIGURE_FORMATS[0]
+
+
 # input kind -> (shot or calibration name -> files)
 INPUT_FILES = {
     "observed": lambda _: [rules.observed.output[0]],
     "cv": lambda _: [rules.emulator.output.cv],
     "emulator_predictions": lambda _: [rules.predict_emulator.output[0]],
     "record": lambda shot: [config["observed"]["records"][shot]["path"]],
-    "sample_simulations": lambda shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS[:1]),
-    "simulations": lambda shot: expand(rules.simulate.output[0], shot=shot, chunk=CHUNKS),
-    "predicted_simulations": lambda shot: expand(
-        rules.run_set_simulate.output[0], run_set="predict", shot=shot, chunk=PREDICT_CHUNKS
-    ),
-    "features": lambda shot: [rules.features.output[0].format(shot=shot)],
-    "predicted_features": lambda shot: expand(rules.run_set_features.output[0], run_set="predict", shot=shot),
+    "sample_simulations": lambda shot: simulations("training", shot)[:1],
+    "simulations": lambda shot: simulations("training", shot),
+    "predicted_simulations": lambda shot: simulations("predict", shot),
+    "features": lambda shot: expand(rules.features.output[0], run_set="training", shot=shot),
+    "predicted_features": lambda shot: expand(rules.features.output[0], run_set="predict", shot=shot),
     "posterior": lambda name: [rules.calibrate.output.samples.format(name=name)],
 }
 assert set(INPUT_FILES) == set(INPUT_KINDS), "figures.smk: INPUT_FILES must cover the catalogue's INPUT_KINDS"

@@ -1,23 +1,29 @@
-# Simulate: one job per shot and chunk of design rows. The design is an `ancient` input: a chunk
-# reruns when its own rows (params.rows_digest: their run ids and the columns this shot reads) or the
-# physics change, not when the design file is rewritten with the same rows or gains another shot's column.
+# Simulate: every run set (training, predict, check) the same way, one job per run set, shot and chunk
+# of design rows, under {RESULTS}/{run_set}/simulations/. The training design is made when the workflow
+# is read (design.smk) and is an `ancient` input: a training chunk reruns when its own rows
+# (params.rows_digest: their run ids and the columns this shot reads) or the physics change, not when
+# the design file is rewritten with the same rows or gains another shot's column. The predict and check
+# designs are made by jobs (predict.smk, calibrate.smk), and their chunks follow them.
 
 
 rule simulate:
     input:
-        design=ancient(DESIGN),
+        design=run_set_design,
     output:
-        f"{RESULTS}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
+        f"{RESULTS}/{{run_set}}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
     log:
-        f"{LOGS}/simulate/{{shot}}/chunk-{{chunk}}.log",
+        f"{LOGS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.log",
     benchmark:
-        f"{BENCHMARKS}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
+        f"{BENCHMARKS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
+    wildcard_constraints:
+        run_set="|".join(RUN_SET_SIZES),
     conda:
         "../envs/shockcal.yaml"
     params:
         settings=lambda w: stage_config(config, "simulate", w.shot),
         rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
-        rows_digest=lambda w: CHUNK_DIGESTS[w.shot][int(w.chunk)],
+        rows_digest=lambda w: CHUNK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "training" else "",
+        end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
-        " --rows {params.rows} --out {output} > {log} 2>&1"
+        " --rows {params.rows} {params.end_time} --out {output} > {log} 2>&1"
