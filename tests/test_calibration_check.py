@@ -124,13 +124,41 @@ def test_shot_without_emulator_is_rejected(small_config):
 
 def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
     _, _, trials = three_toy_trials
-    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass"]
+    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass",
+                                    "status", "reason"]
+    assert (trials["status"] == "ok").all() and (trials["reason"] == "").all()
     assert len(trials) == 3 * 3 and (trials["q05"] < trials["q95"]).all() and (trials["ess"] >= 300).all()
     per_trial = trials.groupby("trial")["truth_hpd_mass"]
     assert (per_trial.nunique() == 1).all() and trials["truth_hpd_mass"].between(0.0, 1.0).all()
     table = coverage_table(pd.concat([trials] * 34, ignore_index=True).assign(trial=np.repeat(np.arange(102), 3)))
     # 102 trials, nominal 0.9: the central 95% binomial band is 0.843-0.951
     assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
+
+
+def test_failed_trials_are_recorded_with_their_reason_not_the_end_of_the_batch(paper_config):
+    emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
+    starved = _settings(paper_config, 100, 300).with_sampler(max_evaluations=50)
+    trials = synthetic_truth(emu, ["toy"], starved, trials=2, seed=4)
+    assert len(trials) == 2 * 3 and sorted(trials["trial"].unique()) == [0, 1]
+    assert (trials["status"] == "failed").all() and trials["reason"].str.contains("max_evaluations").all()
+    assert trials[["q05", "q95", "ess", "truth_hpd_mass"]].isna().all().all()
+    with pytest.raises(InputError, match="no synthetic-truth trial finished: 2 failed, the first with: nautilus"):
+        coverage_table(trials)
+
+
+def test_coverage_leaves_failed_trials_out_and_counts_them(three_toy_trials):
+    _, _, trials = three_toy_trials
+    marked = trials.copy()
+    second = marked["trial"] == 1
+    marked.loc[second, ["q05", "q95", "inside", "ess", "truth_hpd_mass"]] = None
+    marked.loc[second, ["status", "reason"]] = ["failed", "stand-in failure"]
+    table = coverage_table(marked).set_index("parameter")
+    assert (table["trials"] == 2).all() and (table["failed_trials"] == 1).all()
+    finished = trials[~second].groupby("parameter")["inside"].mean()
+    np.testing.assert_allclose(table["coverage90"], finished[table.index].to_numpy(dtype=float))
+    assert joint_coverage(marked)["trials"] == 2
+    older = trials.drop(columns=["status", "reason"]).assign(trial=trials["trial"] + 10)   # batches from before
+    assert (coverage_table(pd.concat([marked, older], ignore_index=True))["trials"] == 5).all()
 
 
 def test_hpd_mass_of_a_known_gaussian():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from shockcal.errors import SamplerError
 from shockcal.sampler import WeightedDraws, nested_sample
 
 
@@ -57,6 +58,16 @@ def test_two_modes_found_in_the_right_proportion():
     upper = draws.points[:, 0] > 0
     assert abs(draws.weights[upper].sum() - 0.7) < 0.04
     assert abs(draws.weights @ np.abs(draws.points[:, 0]) - 3.0) < 0.1
+
+
+def test_a_run_short_of_its_target_at_the_evaluation_limit_is_an_error():
+    # a narrow Gaussian needs thousands of evaluations to reach 5000 effective samples; 1000 are allowed
+    def log_likelihood(theta):
+        return -0.5 * np.sum((theta / 0.01) ** 2, axis=1)
+
+    with pytest.raises(SamplerError, match=r"limit of 1,000 likelihood evaluations \(max_evaluations\).*ESS \d+"):
+        nested_sample(_box_transform(-np.ones(2), np.ones(2)), log_likelihood, 2, n_live=200, n_eff=5000, seed=1,
+                      max_evaluations=1000)
 
 
 def test_same_seed_gives_identical_draws():

@@ -25,7 +25,7 @@ import pandas as pd
 from scipy import stats
 
 from shockcal.emulator import CALIBRATION_FEATURES
-from shockcal.errors import InputError
+from shockcal.errors import InputError, ShockcalError
 from shockcal.plausibility import check_observed_table
 from shockcal.sampler import WeightedDraws, nested_sample
 from shockcal.seeds import stream_seed
@@ -149,14 +149,16 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
 @dataclass(frozen=True)
 class SamplerSettings:
     """nautilus: live points, the effective sample size (Kish) to reach, the number of equal-weight
-    draws written, the seed, and the unit-cube power of named inputs (`nested_sample`'s
-    `cube_power`: where the sampler looks, not the posterior)."""
+    draws written, the seed, the unit-cube power of named inputs (`nested_sample`'s `cube_power`:
+    where the sampler looks, not the posterior) and the likelihood evaluations after which a run that
+    has not reached `n_eff` stops with an error."""
 
     n_live: int = 1000
     n_eff: int = 3000
     draws: int = 10000
     seed: int = 0
     cube_power: Mapping[str, float] = field(default_factory=dict)
+    max_evaluations: int = 500_000
 
 
 @dataclass(frozen=True)
@@ -178,7 +180,8 @@ class CalibrationSettings:
         section = config["calibration"]["check"] if check else config["calibration"]
         draws = section["n_eff"] if check else section["draws"]
         seed = stream_seed(config["study"]["seed"], "calibration", *shots)
-        sampler = SamplerSettings(section["n_live"], section["n_eff"], draws, seed, config["calibration"]["cube_power"])
+        sampler = SamplerSettings(section["n_live"], section["n_eff"], draws, seed, config["calibration"]["cube_power"],
+                                  config["calibration"]["max_evaluations"])
         return cls(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                    {name: box["unit"] for name, box in config["inputs"].items()})
 
@@ -194,7 +197,7 @@ def sample(problem: Problem, settings: SamplerSettings, other_powers: str = "err
     evaluations, Kish ESS, distinct draws). `other_powers`: `Problem.cube_power`'s `others`."""
     power = problem.cube_power(settings.cube_power, other_powers)
     weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
-                             settings.n_eff, settings.seed, power)
+                             settings.n_eff, settings.seed, power, settings.max_evaluations)
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     frame = pd.DataFrame(weighted.points[rows], columns=[*problem.names, "lambda_y"])
     frame["log_likelihood"] = weighted.log_likelihood[rows]
@@ -273,11 +276,13 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     each feature is added and the features are calibrated with `settings` (the sampler reseeded from
     the trial's stream). Columns:
     trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS),
-    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows).
+    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows), status ("ok" or
+    "failed") and reason. A trial that fails (the sampler at `max_evaluations`, no positive noise draw)
+    is recorded with its reason and empty results, and the next one runs; the coverage leaves it out
+    (`usable_trials`) and counts it.
     """
     trial_ids = range(trials) if isinstance(trials, int) else trials
     names = emulator.required_inputs(shots)
-    sd_fraction = settings.sd_fraction
     hydro_draws = None if truths is None else truths.table(names, shots)
     if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
@@ -285,24 +290,42 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     rows = []
     for done, trial in enumerate(trial_ids, 1):
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
-        if hydro_draws is None:
-            theta, eta = _emulator_truth(emulator, shots, names, rng)
-        else:
-            theta, eta = hydro_draws[trial]
-        lam, y = _noisy_features(eta, sd_fraction, rng, trial)
-        observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
-        trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
-        draws, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
-        summary = summary.set_index("parameter")
-        truth_ll = Problem.build(emulator, shots, observed, sd_fraction).log_likelihood(np.append(theta, lam)[None])[0]
-        mass = hpd_mass(log_density(draws["log_likelihood"], draws["lambda_y"]), log_density(truth_ll, lam))
-        for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
-            q05, q95 = summary.loc[name, ["q05", "q95"]]
-            rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                         "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
-                         "truth_hpd_mass": mass})
+        try:
+            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws)
+        except ShockcalError as error:     # recorded and left out of the coverage, never the end of the batch
+            log.warning("synthetic trial %d failed: %s", trial, error)
+            rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
+                     for name in [*names, "lambda_y"]]
         log.info("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))
-    return pd.DataFrame(rows)
+    table = pd.DataFrame(rows, columns=CHECK_COLUMNS)
+    table["inside"] = table["inside"].astype("boolean")
+    return table
+
+
+CHECK_COLUMNS = ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass", "status", "reason"]
+
+
+def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws) -> list[dict]:
+    """One synthetic-truth trial: its truth, pseudo-measurement and calibration; a row per parameter."""
+    if hydro_draws is None:
+        theta, eta = _emulator_truth(emulator, shots, names, rng)
+    else:
+        theta, eta = hydro_draws[trial]
+    lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial)
+    observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
+    trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
+    draws, summary, _ = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
+    summary = summary.set_index("parameter")
+    problem = Problem.build(emulator, shots, observed, settings.sd_fraction)
+    truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
+    mass = hpd_mass(log_density(draws["log_likelihood"], draws["lambda_y"]), log_density(truth_ll, lam))
+    rows = []
+    for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
+        q05, q95 = summary.loc[name, ["q05", "q95"]]
+        rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
+                     "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
+                     "truth_hpd_mass": mass, "status": "ok", "reason": ""})
+    return rows
 
 
 def log_density(log_likelihood, lambda_y):
@@ -371,12 +394,26 @@ class HydroTruths:
         return list(zip(usable[names].to_numpy(float), usable[columns].to_numpy(float)))
 
 
+def usable_trials(trials: pd.DataFrame) -> pd.DataFrame:
+    """The rows of trials that finished: status "ok", or no status (rows from before the status
+    column, 2026-11-25, are all of finished trials)."""
+    return trials if "status" not in trials else trials[trials["status"].fillna("ok") == "ok"]
+
+
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
-    """Per parameter: trials, share of 90% intervals holding the truth (nominal 0.90), the central 95%
-    binomial band of that share for a calibrated method (band_low, band_high), whether it lies in the
-    band, and the smallest Kish ESS of any trial."""
-    table = trials.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
+    """Per parameter, over the trials that finished (`usable_trials`; failed_trials counts the others):
+    trials, share of 90% intervals holding the truth (nominal 0.90), the central 95% binomial band of
+    that share for a calibrated method (band_low, band_high), whether it lies in the band, and the
+    smallest Kish ESS of any trial."""
+    usable = usable_trials(trials).astype({"inside": bool})
+    if usable.empty:
+        reasons = trials.groupby("trial")["reason"].first() if "reason" in trials else pd.Series(dtype=str)
+        raise InputError(f"no synthetic-truth trial finished: {len(reasons)} failed"
+                         + (f", the first with: {reasons.iloc[0]}" if len(reasons) else ""))
+    table = usable.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
                                                         min_ess=("ess", "min")).reset_index()
+    failed = trials.groupby("parameter", sort=False)["trial"].nunique() - usable.groupby("parameter")["trial"].nunique()
+    table["failed_trials"] = table["parameter"].map(failed).fillna(0).astype(int)
     table["band_low"], table["band_high"] = binomial_band(table["trials"])
     table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
     return table
@@ -386,7 +423,7 @@ def joint_coverage(trials: pd.DataFrame) -> dict:
     """The joint check from the trials' `truth_hpd_mass`: the share of trials whose truth lies in the
     90% highest-density region, its central 95% binomial band, and the Kolmogorov-Smirnov p-value of
     the masses against the uniform distribution they follow for a calibrated method."""
-    mass = trials.groupby("trial")["truth_hpd_mass"].first().to_numpy()
+    mass = usable_trials(trials).groupby("trial")["truth_hpd_mass"].first().to_numpy()
     band_low, band_high = binomial_band(len(mass))
     return {"trials": len(mass), "coverage90": float(np.mean(mass <= 0.9)), "band_low": band_low,
             "band_high": band_high, "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}

@@ -11,3 +11,8 @@ class ConfigError(ShockcalError):
 
 class InputError(ShockcalError):
     """An input table or record is unusable; the message names the file, row or column."""
+
+
+class SamplerError(ShockcalError):
+    """A sampler stopped before its target (e.g. at its likelihood-evaluation limit); the message
+    gives how far it got and the setting that stopped it."""

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import logsumexp
 
+from shockcal.errors import SamplerError
+
 
 @dataclass
 class WeightedDraws:
@@ -51,8 +53,10 @@ class WeightedDraws:
 
 
 def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff: int, seed: int,
-                  cube_power=None) -> WeightedDraws:
-    """Run nautilus until the weighted draws reach `n_eff` effective (Kish) samples.
+                  cube_power=None, max_evaluations: float = np.inf) -> WeightedDraws:
+    """Run nautilus until the weighted draws reach `n_eff` effective (Kish) samples, or raise
+    `SamplerError` when that takes more than `max_evaluations` likelihood evaluations (a bound that
+    never shrinks, seen upstream as nautilus issues #37 and #66, would otherwise run forever).
 
     `prior_transform` maps (N, ndim) points of the unit cube to parameters; `log_likelihood` takes
     (N, ndim) parameters to (N,). One network per bound (nautilus's default is four: on this
@@ -84,7 +88,10 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
 
     sampler = Sampler(lambda u: u, sampled_log_likelihood, n_dim=ndim, n_live=n_live, vectorized=True, seed=seed,
                       n_networks=1)
-    sampler.run(n_eff=n_eff, discard_exploration=True, verbose=False)
+    if not sampler.run(n_eff=n_eff, n_like_max=max_evaluations, discard_exploration=True, verbose=False):
+        raise SamplerError(f"nautilus stopped at its limit of {max_evaluations:,.0f} likelihood evaluations "
+                           f"(max_evaluations) before the effective sample size reached {n_eff}: ESS "
+                           f"{sampler.n_eff:.0f}, exploration {'done' if sampler.explored else 'not finished'}")
     cube, log_w, log_l = (np.asarray(a) for a in sampler.posterior())
     return WeightedDraws(to_parameters(cube), log_w - logsumexp(log_w), log_l - log_density_ratio(cube),
                          float(sampler.log_z), int(sampler.n_like))

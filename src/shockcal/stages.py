@@ -44,10 +44,11 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # one calibration (single shot or joint)
     "calibrate": ("study.seed", "calibration.n_live", "calibration.n_eff", "calibration.draws",
-                  "calibration.cube_power", "observed.sd_fraction", "checks.observed_units", "inputs"),
+                  "calibration.cube_power", "calibration.max_evaluations", "observed.sd_fraction",
+                  "checks.observed_units", "inputs"),
     # a batch of synthetic-truth trials
-    "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "observed.sd_fraction",
-                        "checks.observed_units", "inputs"),
+    "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
+                        "observed.sd_fraction", "checks.observed_units", "inputs"),
     # the posterior rows run through the hydrocode for predictions
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
