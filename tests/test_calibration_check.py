@@ -219,7 +219,10 @@ def test_coverage_command_merges_batches_and_rejects_a_repeated_trial(tmp_path, 
     assert main(["coverage", "--trials", first, second, "--out", str(tmp_path / "all.parquet")]) == 0
     merged = read_table(tmp_path / "all.parquet")
     assert merged["trial"].tolist() == sorted(merged["trial"].tolist()) and merged["trial"].nunique() == 20
-    assert coverage_table(merged)["coverage90"].tolist() == [0.8, 0.8]
+    table = coverage_table(merged)
+    assert table["coverage90"].tolist() == [0.8, 0.8]
+    # the misses: q95 = 0.1 below the truth 0.5, so all above q95, none below q05
+    assert table["above_q95"].tolist() == [0.2, 0.2] and table["below_q05"].tolist() == [0.0, 0.0]
     again = batch(range(5, 8), "b2.parquet")
     assert main(["coverage", "--trials", second, again, "--out", str(tmp_path / "bad.parquet")]) == 2
     assert "trial 5 is in more than one" in capsys.readouterr().err

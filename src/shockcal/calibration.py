@@ -403,15 +403,18 @@ def usable_trials(trials: pd.DataFrame) -> pd.DataFrame:
 def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     """Per parameter, over the trials that finished (`usable_trials`; failed_trials counts the others):
     trials, share of 90% intervals holding the truth (nominal 0.90), the central 95% binomial band of
-    that share for a calibrated method (band_low, band_high), whether it lies in the band, and the
-    smallest Kish ESS of any trial."""
+    that share for a calibrated method (band_low, band_high), whether it lies in the band, the shares
+    of truths below q05 and above q95 (nominal 0.05 each: a lopsided miss points to a shifted
+    posterior, an even one to a narrow one), and the smallest Kish ESS of any trial."""
     usable = usable_trials(trials).astype({"inside": bool})
+    usable = usable.assign(below_q05=usable["truth"] < usable["q05"], above_q95=usable["truth"] > usable["q95"])
     if usable.empty:
         reasons = trials.groupby("trial")["reason"].first() if "reason" in trials else pd.Series(dtype=str)
         raise InputError(f"no synthetic-truth trial finished: {len(reasons)} failed"
                          + (f", the first with: {reasons.iloc[0]}" if len(reasons) else ""))
-    table = usable.groupby("parameter", sort=False).agg(trials=("trial", "nunique"), coverage90=("inside", "mean"),
-                                                        min_ess=("ess", "min")).reset_index()
+    table = usable.groupby("parameter", sort=False).agg(
+        trials=("trial", "nunique"), coverage90=("inside", "mean"), below_q05=("below_q05", "mean"),
+        above_q95=("above_q95", "mean"), min_ess=("ess", "min")).reset_index()
     failed = trials.groupby("parameter", sort=False)["trial"].nunique() - usable.groupby("parameter")["trial"].nunique()
     table["failed_trials"] = table["parameter"].map(failed).fillna(0).astype(int)
     table["band_low"], table["band_high"] = binomial_band(table["trials"])
