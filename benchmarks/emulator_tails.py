@@ -5,8 +5,10 @@ Per feature: RMSE (m/s), the emulator's median sd, the share of errors inside it
 z^2 (1 when the sds are right). Then the 12-feature Mahalanobis distance of each run's error against
 chi-square: its mean, the share beyond the 90% point (0.10 when the covariance is right), the same with
 the calibration's observation noise added and for errors drawn from the emulator itself, and the
-runs with the largest distances. Needs `make check`'s check runs and the emulator under `results/`;
-prints, never asserts. Usage: python benchmarks/emulator_tails.py [RESULTS_DIR]
+runs with the largest distances. The shots and the noise's sd fraction come from the study's config;
+the noise is drawn as the check draws it. Needs `make check`'s check runs and the emulator under the
+results directory; prints, never asserts.
+Usage: python benchmarks/emulator_tails.py [RESULTS_DIR [CONFIG]]
 """
 
 import sys
@@ -16,11 +18,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.calibration import LAMBDA_Y_PRIOR, HydroTruths
+from shockcal.calibration import HydroTruths, _noisy_features
+from shockcal.config import load_config
 from shockcal.emulator import Emulator
 
-SHOTS = ["104S", "105S", "106S"]
-SD_FRACTION = 0.01          # observed.sd_fraction of the paper's study
 NOISE_DRAWS = 50
 
 
@@ -28,33 +29,35 @@ def mahalanobis(err: np.ndarray, cov: np.ndarray) -> np.ndarray:
     return np.einsum("ni,nij,nj->n", err, np.linalg.inv(cov), err)
 
 
-def share_beyond_90(eta, cov, errors, rng) -> float:
+def share_beyond_90(eta, cov, errors, sd_fraction, rng) -> float:
     """Share of (run, noise draw) residuals beyond chi-square's 90% point under emulator + noise
-    covariance, the noise as the calibration models it (lambda_y from its prior)."""
-    shape, rate = LAMBDA_Y_PRIOR
+    covariance; the noise drawn by the check's own `_noisy_features` (lambda_y from its prior)."""
     limit, beyond = stats.chi2.ppf(0.9, eta.shape[1]), []
     for _ in range(NOISE_DRAWS):
-        noise_sd = SD_FRACTION * np.abs(eta) / np.sqrt(rng.gamma(shape, 1 / rate, size=len(eta)))[:, None]
-        total = errors() + noise_sd * rng.normal(size=eta.shape)
+        lam, noisy = zip(*(_noisy_features(e, sd_fraction, rng, run) for run, e in enumerate(eta)))
+        noise_sd = sd_fraction * np.abs(eta) / np.sqrt(np.array(lam))[:, None]
+        total = errors() + (np.array(noisy) - eta)
         beyond.append(mahalanobis(total, cov + np.einsum("ni,ij->nij", noise_sd**2, np.eye(eta.shape[1]))) > limit)
     return float(np.mean(beyond))
 
 
-def main(results: Path) -> int:
+def main(results: Path, config_path: Path) -> int:
     if not (results / "check" / "design.parquet").exists():
         print(f"skipped: no check runs under {results} (run `make check` first)")
         return 0
+    config = load_config(config_path)
+    shots, sd_fraction = list(config["shots"]), config["observed"]["sd_fraction"]
     emulator = Emulator.load(results / "emulator")
     truths = HydroTruths.read(results / "check" / "design.parquet",
-                              {s: results / "check" / "features" / f"{s}.parquet" for s in SHOTS}, SHOTS)
-    names = emulator.required_inputs(SHOTS)
-    pairs = truths.table(names, SHOTS)
+                              {s: results / "check" / "features" / f"{s}.parquet" for s in shots}, shots)
+    names = emulator.required_inputs(shots)
+    pairs = truths.table(names, shots)
     theta, eta = np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
-    mean, cov = emulator.predict(dict(zip(names, theta.T)), SHOTS)
+    mean, cov = emulator.predict(dict(zip(names, theta.T)), shots)
     err = eta - mean
     sd = np.sqrt(np.einsum("nii->ni", cov))
     z = err / sd
-    columns = [f"{s}:{f}" for s in SHOTS for f in emulator.feature_names]
+    columns = [f"{s}:{f}" for s in shots for f in emulator.feature_names]
     print(f"{len(eta)} check runs")
     print(pd.DataFrame({"rmse_m_s": np.sqrt((err**2).mean(0)), "emulator_sd_median_m_s": np.median(sd, 0),
                         "inside_90_band": (np.abs(z) <= stats.norm.ppf(0.95)).mean(0), "mean_z2": (z**2).mean(0)},
@@ -64,9 +67,9 @@ def main(results: Path) -> int:
           f"{(d2 > stats.chi2.ppf(0.9, dof)).mean():.2f} (0.10), KS p {stats.kstest(d2, stats.chi2(dof).cdf).pvalue:.3g}")
     rng = np.random.default_rng(1)
     chol = np.linalg.cholesky(cov)
-    print(f"with observation noise: share beyond {share_beyond_90(eta, cov, lambda: err, rng):.3f}; "
+    print(f"with observation noise: share beyond {share_beyond_90(eta, cov, lambda: err, sd_fraction, rng):.3f}; "
           "errors drawn from the emulator's own covariance: "
-          f"{share_beyond_90(eta, cov, lambda: np.einsum('nij,nj->ni', chol, rng.normal(size=eta.shape)), rng):.3f}")
+          f"{share_beyond_90(eta, cov, lambda: np.einsum('nij,nj->ni', chol, rng.normal(size=eta.shape)), sd_fraction, rng):.3f}")
     top = np.argsort(d2)[::-1][:5]
     print("largest distances (run order among the usable runs: distance, worst feature, its |z|):")
     for i in top:
@@ -76,4 +79,5 @@ def main(results: Path) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(Path(sys.argv[1] if len(sys.argv) > 1 else "results")))
+    args = sys.argv[1:]
+    sys.exit(main(Path(args[0] if args else "results"), Path(args[1] if len(args) > 1 else "config/config.yaml")))
