@@ -17,6 +17,7 @@ from shockcal.calibration import (
     sample,
     weighted_quantiles,
 )
+from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 
 
@@ -25,9 +26,13 @@ class StandInEmulator:
 
     feature_names = ["v_elastic", "v_plastic"]
 
-    def __init__(self, mean_fn, names, lower, upper, cov):
+    def __init__(self, mean_fn, names, lower, upper, cov, error=None):
         self.mean_fn, self.names = mean_fn, names
         self.lower, self.upper, self.cov = np.array(lower, float), np.array(upper, float), np.asarray(cov, float)
+        self.error = error or ErrorModel()
+
+    def error_groups(self, shots):
+        return [(np.arange(len(self.cov)), self.error)]
 
     def required_inputs(self, shots):
         return self.names

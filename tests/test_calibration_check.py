@@ -22,6 +22,7 @@ from shockcal.calibration import (
     log_density,
     synthetic_truth,
 )
+from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 
 FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -64,6 +65,9 @@ class ShotEmulator:
             blocks.append(m)
         f = 4 * len(shots)
         return np.hstack(blocks), np.tile(self.sd**2 * np.eye(f), (n, 1, 1))
+
+    def error_groups(self, shots):
+        return [(np.arange(4 * len(shots)), ErrorModel())]
 
 
 def observed_at(emulator, shots, theta: dict) -> pd.DataFrame:

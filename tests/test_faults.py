@@ -20,6 +20,7 @@ from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.cli import main, parse_pairs, parse_span
 from shockcal.config import load_config, validate_config
 from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
+from shockcal.error_model import ErrorModel
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.features import check_failures
 from shockcal.io import atomic_path, read_table, write_table
@@ -190,6 +191,9 @@ class StandInEmulator:
 
     def input_bounds(self, names):
         return np.array([0.0005]), np.array([0.01])
+
+    def error_groups(self, shots):
+        return [(np.arange(4 * len(shots)), ErrorModel())]
 
 
 PUBLISHED_104S = {"t_jumpoff": 0.917, "v_jumpoff": 2.26, "t_elastic": 0.943, "v_elastic": 69.7, "t_plastic": 1.799,

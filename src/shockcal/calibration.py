@@ -2,9 +2,11 @@
 
 For the shots calibrated together, the measured features y (m/s, four per shot) are modelled as
 
-    y ~ N( eta(theta), C_eta(theta) + Sigma_y / lambda_y ),
+    y - eta(theta) ~ t_nu( 0, s C_eta(theta) + Sigma_y / lambda_y ),
 
-eta and C_eta the emulator's predictive mean and covariance, Sigma_y diagonal with sd =
+eta and C_eta the emulator's predictive mean and covariance, (nu, s) its error model (a Student t
+fitted to its K-fold errors, `shockcal.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
+term per emulator block (their errors are independent), Sigma_y diagonal with sd =
 `observed.sd_fraction` (1%) of each measured feature, lambda_y ~ Gamma(5, 5), theta uniform on the
 prior box. The emulator's hyperparameters are fixed at their fitted mode (modular Bayes; see
 docs/calibration.md). A point is (theta in native units, lambda_y); both priors are reached from the
@@ -25,6 +27,7 @@ import pandas as pd
 from scipy import stats
 
 from shockcal.emulator import CALIBRATION_FEATURES
+from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError, ShockcalError
 from shockcal.plausibility import check_observed_table
 from shockcal.sampler import WeightedDraws, nested_sample
@@ -43,6 +46,8 @@ class Problem:
     study's `Emulator` through `Problem.build`). Points are (theta, lambda_y). `prior_transform`
     and `log_likelihood` are the pair a nested or SMC sampler takes (vectorised over a batch of
     points); `log_posterior` is the same density for MCMC in (theta, log lambda_y).
+    `error_groups`: (feature columns, ErrorModel) pairs covering the features once; default, one
+    Gaussian over all of them.
     """
 
     predict: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -52,6 +57,7 @@ class Problem:
     lower: np.ndarray
     upper: np.ndarray
     label: str = "calibration"
+    error_groups: list[tuple[np.ndarray, ErrorModel]] | None = None
 
     @classmethod
     def build(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed"):
@@ -63,7 +69,8 @@ class Problem:
         def predict(theta):
             return emulator.predict(dict(zip(names, theta.T)), list(shots))
 
-        return cls(predict, y, sd_fraction * np.abs(y), names, np.asarray(lower), np.asarray(upper), "+".join(shots))
+        return cls(predict, y, sd_fraction * np.abs(y), names, np.asarray(lower), np.asarray(upper), "+".join(shots),
+                   emulator.error_groups(shots))
 
     @property
     def ndim(self) -> int:
@@ -87,14 +94,18 @@ class Problem:
         return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0])
 
     def log_likelihood(self, points: np.ndarray) -> np.ndarray:
-        """Gaussian log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
+        """Log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
         inside the box, normalising constants included (so the evidence is a true marginal likelihood).
         A non-finite value is an error naming the point: it means the emulator is broken there."""
         points = np.atleast_2d(points)
         theta, lam = points[:, :-1], points[:, -1]
         mean, cov = self.predict(theta)
-        cov = cov + (self.obs_sd**2)[None, :] * np.eye(len(self.observed))[None] / lam[:, None, None]
-        value = _gaussian_log_density(self.observed - mean, cov)
+        resid = self.observed - mean
+        groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
+        value = np.zeros(len(points))
+        for cols, error in groups:
+            noise_cov = np.diag(self.obs_sd[cols] ** 2)[None] / lam[:, None, None]
+            value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_cov)
         bad = ~np.isfinite(value)
         if bad.any():
             point = dict(zip([*self.names, "lambda_y"], points[np.argmax(bad)].tolist()))
@@ -114,18 +125,6 @@ class Problem:
             shape, rate = LAMBDA_Y_PRIOR
             out[inside] = self.log_likelihood(np.column_stack([x[inside, :-1], lam])) + shape * log_lam - rate * lam
         return out
-
-
-def _gaussian_log_density(resid: np.ndarray, cov: np.ndarray) -> np.ndarray:
-    """log N(resid; 0, cov) for a batch (N, F) and (N, F, F); NaN where cov is not positive definite."""
-    try:
-        chol = np.linalg.cholesky(cov)
-    except np.linalg.LinAlgError:      # locate the bad rows one by one
-        return np.array([_gaussian_log_density(r[None], c[None])[0] if np.all(np.linalg.eigvalsh(c) > 0)
-                         else np.nan for r, c in zip(resid, cov)])
-    z = np.linalg.solve(chol, resid[..., None])[..., 0]
-    log_det = 2.0 * np.log(np.diagonal(chol, axis1=1, axis2=2)).sum(axis=1)
-    return -0.5 * (np.sum(z**2, axis=1) + log_det + resid.shape[1] * np.log(2 * np.pi))
 
 
 def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> np.ndarray:
@@ -357,11 +356,14 @@ def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
 
 def _emulator_truth(emulator, shots, names, rng):
     """(theta, features): theta uniform on the box, features from the emulator's predictive
-    distribution at theta."""
+    distribution at theta (its error model's, block by block)."""
     lower, upper = emulator.input_bounds(names)
     theta = rng.uniform(lower, upper)
     mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
-    return theta, rng.multivariate_normal(mean[0], cov[0])
+    features = np.empty(mean.shape[1])
+    for cols, error in emulator.error_groups(shots):
+        features[cols] = error.sample(mean[0, cols], cov[0, cols[:, None], cols[None, :]], rng)
+    return theta, features
 
 
 @dataclass

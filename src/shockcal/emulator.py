@@ -34,12 +34,13 @@ from scipy.special import expit
 from threadpoolctl import ThreadpoolController, threadpool_limits
 
 from shockcal.config import STRENGTH_INPUTS, shot_config
+from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
 from shockcal.io import atomic_path
 from shockcal.seeds import stream_seed
 
-FORMAT_VERSION = 3                  # 3: input powers for n and m (2 had the strain^n input only)
+FORMAT_VERSION = 4                  # 4: the error model (3 had no error tails, 2 the strain^n input only)
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
@@ -130,11 +131,12 @@ class Settings:
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
     cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
     switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
+    error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
 
     @classmethod
     def from_config(cls, settings: dict, seed: int) -> Settings:
         keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd",
-                "cv_warm_start", "switch_ratio")
+                "cv_warm_start", "switch_ratio", "error_tails")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
 
 
@@ -151,12 +153,27 @@ class Switch:
 
 @dataclass
 class HeldOut:
-    """Held-out predictions of a cross-validation scheme: row indices, mean and sd (N, F)."""
+    """Held-out predictions of a cross-validation scheme: row indices, mean and sd (N, F), and the
+    covariance (N, F, F) where the scheme has it (not closed-form LOO)."""
 
     scheme: str
     rows: np.ndarray
     mean: np.ndarray
     sd: np.ndarray
+    cov: np.ndarray | None = None
+
+    def scaled(self, factors: np.ndarray) -> HeldOut:
+        """The same predictions with sd (and covariance) scaled by per-row, per-feature factors (N, F)."""
+        cov = None if self.cov is None else self.cov * factors[:, :, None] * factors[:, None, :]
+        return HeldOut(self.scheme, self.rows, self.mean, self.sd * factors, cov)
+
+    def distances(self, y: np.ndarray) -> tuple[np.ndarray, int]:
+        """Squared Mahalanobis distance of each held-out error (y[rows] - mean) under its covariance,
+        in the space the covariance spans (a pseudo-inverse: duplicated outputs make it singular),
+        and that space's dimension (the covariances' median rank)."""
+        err = y[self.rows] - self.mean
+        rank = int(np.median(np.linalg.matrix_rank(self.cov, hermitian=True)))
+        return np.einsum("ni,nij,nj->n", err, np.linalg.pinv(self.cov, hermitian=True), err), rank
 
 
 def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
@@ -181,7 +198,7 @@ class PCGPEmulator:
     """
 
     def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings, sd_factor=None, switches=None):
+                 settings: Settings, sd_factor=None, switches=None, error: ErrorModel | None = None):
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
         self.residual_cov = np.asarray(residual_cov)
@@ -191,6 +208,7 @@ class PCGPEmulator:
         self.sd_factor = np.ones((2, len(self.mean))) if sd_factor is None else np.asarray(sd_factor, dtype=float)
         self.switches: list[Switch] = list(switches or [])
         self.kfold: HeldOut | None = None          # the K-fold of the sd calibration, kept for reporting
+        self.error = error or ErrorModel()         # the error's distribution around (mean, covariance)
         self.weights = self.project((self.y_train - self.mean) / self.scale)
         self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h, family=settings.family)
                     for j, h in enumerate(hypers)]
@@ -212,14 +230,23 @@ class PCGPEmulator:
         quantile of its K-fold |error| / sd over 1.645: one factor per feature, never per run, and
         a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
         traces), when there are at least SWITCH_MIN_RUNS of them.
+
+        With `settings.error_tails == "student_t"`, the error model's (dof, scale) are fitted to
+        the Mahalanobis distances of the same K-fold's errors (`shockcal.error_model`).
         """
         settings = settings or Settings()
         model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
         model.switches = list(switches or [])
-        if settings.calibrate_sd:
+        if settings.calibrate_sd or settings.error_tails == "student_t":
             held, folds = model._kfold(settings.cv_folds, settings.seed)
-            model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
-            model.kfold = _cross_fitted(model, held, folds)
+            if settings.calibrate_sd:
+                model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
+                held = _cross_fitted(model, held, folds)
+            model.kfold = held
+            if settings.error_tails == "student_t":
+                model.error = ErrorModel.fit(*held.distances(model.y_train))
+                log.info("error model: Student t, dof %.2f, scale %.3f (from %d K-fold errors)",
+                         model.error.dof, model.error.scale, len(held.rows))
         return model
 
     @classmethod
@@ -346,21 +373,20 @@ class PCGPEmulator:
             empty = np.empty((0, self.y_train.shape[1]))
             return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
         held = self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
-        held.sd *= self.sd_factors(held.mean)
-        return held
+        return held.scaled(self.sd_factors(held.mean))
 
     def _held_out(self, scheme, tests, trains) -> HeldOut:
         starts = [gp.hyper for gp in self.gps] if self.settings.cv_warm_start else None
         models = self._fit_many(self.x_train, self.y_train, np.zeros(len(self.lower)), np.ones(len(self.upper)),
                                 self.settings, trains, starts)
         rows = np.concatenate(tests)
-        mean, sd = np.empty((len(rows), self.y_train.shape[1])), np.empty((len(rows), self.y_train.shape[1]))
+        f = self.y_train.shape[1]
+        mean, cov = np.empty((len(rows), f)), np.empty((len(rows), f, f))
         start = 0
         for model, test in zip(models, tests):
-            m, c = model.predict_scaled(self.x_train[test])
-            mean[start:start + len(test)], sd[start:start + len(test)] = m, np.sqrt(np.einsum("nff->nf", c))
+            mean[start:start + len(test)], cov[start:start + len(test)] = model.predict_scaled(self.x_train[test])
             start += len(test)
-        return HeldOut(scheme, rows, mean, sd)
+        return HeldOut(scheme, rows, mean, np.sqrt(np.einsum("nff->nf", cov)), cov)
 
     def to_arrays(self, prefix: str = "") -> dict:
         arrays = {"lower": self.lower, "upper": self.upper, "mean": self.mean, "scale": self.scale,
@@ -370,6 +396,7 @@ class PCGPEmulator:
 
     def to_json(self) -> dict:
         return {"settings": asdict(self.settings), "switches": [asdict(sw) for sw in self.switches],
+                "error": self.error.to_json(),
                 "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
                                      "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
 
@@ -378,7 +405,8 @@ class PCGPEmulator:
         hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
         return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
-                   arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]])
+                   arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]],
+                   ErrorModel.from_json(meta["error"]))
 
     def save(self, path) -> Path:
         """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
@@ -419,11 +447,11 @@ def _blend(factors: np.ndarray, weight: np.ndarray) -> np.ndarray:
 def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
     """K-fold sd scaled, fold by fold, by the factors of the other folds (an honest coverage)."""
     fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
-    sd = held.sd.copy()
+    factors = np.empty_like(held.sd)
     for j in range(len(folds)):
         here = fold_of == j
-        sd[here] *= _blend(_sd_factor(model, held, ~here), model.switch_weight(held.mean[here]))
-    return HeldOut(held.scheme, held.rows, held.mean, sd)
+        factors[here] = _blend(_sd_factor(model, held, ~here), model.switch_weight(held.mean[here]))
+    return held.scaled(factors)
 
 
 def _component_count(singular_values: np.ndarray, n_components: float) -> int:
@@ -487,6 +515,15 @@ class Emulator:
             mean[:, dst] = m[:, src]
             cov[:, dst[:, None], dst[None, :]] = c[:, src[:, None], src[None, :]]
         return mean, cov
+
+    def error_groups(self, shots) -> list[tuple[np.ndarray, ErrorModel]]:
+        """Per block, the columns of `predict(..., shots)` it predicts and its error model: blocks'
+        errors are independent, so a likelihood is the sum of one error density per group."""
+        shots = list(shots)
+        self._check_shots(shots)
+        k = len(self.feature_names)
+        return [(np.concatenate([np.arange(k) + k * shots.index(s) for s in block.shots if s in shots]),
+                 block.model.error) for block in self.blocks if set(block.shots) & set(shots)]
 
     def _complete(self, inputs, block: Block, n: int) -> dict:
         """The block's design inputs, those not given held at mid-box."""
