@@ -1,13 +1,15 @@
 """The study emulator's errors on the hydrocode-truth runs, which it never saw, measured against its own
-predictive covariance (docs/calibration.md, "Measured: hydrocode truth").
+predictive distribution (docs/emulator.md, "Error tails"; docs/calibration.md, "Measured: hydrocode truth").
 
 Per feature: RMSE (m/s), the emulator's median sd, the share of errors inside its 90% band and the mean
-z^2 (1 when the sds are right). Then the 12-feature Mahalanobis distance of each run's error against
-chi-square: its mean, the share beyond the 90% point (0.10 when the covariance is right), the same with
-the calibration's observation noise added and for errors drawn from the emulator itself, and the
-runs with the largest distances. The shots and the noise's sd fraction come from the study's config;
-the noise is drawn as the check draws it. Needs `make check`'s check runs and the emulator under the
-results directory; prints, never asserts.
+z^2 (1 when the sds are right). Then, per emulator block, the Mahalanobis distance of each run's error
+under the covariance, against the Gaussian (chi-square) and against the block's fitted error model (a
+Student t: d^2 / (F scale) ~ F(F, dof)): the share beyond each one's 90% and 99% points (0.10 and 0.01
+when the model is right) and the KS p-value; with the calibration's observation noise added, the share
+of real residuals beyond the 90% point of residuals the model draws itself; and the runs with the
+largest distances. The shots and the noise's sd fraction come from the study's config; the noise is drawn as
+the check draws it. Needs `make check`'s check runs and the emulator under the results directory;
+prints, never asserts.
 Usage: python benchmarks/emulator_tails.py [RESULTS_DIR [CONFIG]]
 """
 
@@ -21,6 +23,7 @@ from scipy import stats
 from shockcal.calibration import HydroTruths, _noisy_features
 from shockcal.config import load_config
 from shockcal.emulator import Emulator
+from shockcal.error_model import ErrorModel
 
 NOISE_DRAWS = 50
 
@@ -29,16 +32,27 @@ def mahalanobis(err: np.ndarray, cov: np.ndarray) -> np.ndarray:
     return np.einsum("ni,nij,nj->n", err, np.linalg.inv(cov), err)
 
 
-def share_beyond_90(eta, cov, errors, sd_fraction, rng) -> float:
-    """Share of (run, noise draw) residuals beyond chi-square's 90% point under emulator + noise
-    covariance; the noise drawn by the check's own `_noisy_features` (lambda_y from its prior)."""
-    limit, beyond = stats.chi2.ppf(0.9, eta.shape[1]), []
+def distance_cdf(model: ErrorModel, dof_features: int):
+    """CDF of d^2 under the model's own covariance scale: chi-square, or F-distributed for a t."""
+    if np.isinf(model.dof):
+        return stats.chi2(dof_features, scale=model.scale).cdf
+    return stats.f(dof_features, model.dof, scale=dof_features * model.scale).cdf
+
+
+def share_beyond_90_with_noise(eta, cov, err, model: ErrorModel, sd_fraction, rng) -> float:
+    """Share of real residuals (error + noise) whose distance under cov + noise covariance lies beyond
+    the 90% point of the same distance for residuals the model draws itself (its error + the same
+    noise): 0.10 when the model describes error + noise. The noise is drawn by the check's own
+    `_noisy_features` (lambda_y from its prior)."""
+    f, real, simulated = eta.shape[1], [], []
     for _ in range(NOISE_DRAWS):
         lam, noisy = zip(*(_noisy_features(e, sd_fraction, rng, run) for run, e in enumerate(eta)))
-        noise_sd = sd_fraction * np.abs(eta) / np.sqrt(np.array(lam))[:, None]
-        total = errors() + (np.array(noisy) - eta)
-        beyond.append(mahalanobis(total, cov + np.einsum("ni,ij->nij", noise_sd**2, np.eye(eta.shape[1]))) > limit)
-    return float(np.mean(beyond))
+        noise = np.array(noisy) - eta
+        shape = cov + np.einsum("ni,ij->nij", (sd_fraction * np.abs(eta)) ** 2 / np.array(lam)[:, None], np.eye(f))
+        drawn = np.array([model.sample(np.zeros(f), c, rng) for c in cov])
+        real.append(mahalanobis(err + noise, shape))
+        simulated.append(mahalanobis(drawn + noise, shape))
+    return float(np.mean(np.concatenate(real) > np.quantile(np.concatenate(simulated), 0.9)))
 
 
 def main(results: Path, config_path: Path) -> int:
@@ -62,19 +76,23 @@ def main(results: Path, config_path: Path) -> int:
     print(pd.DataFrame({"rmse_m_s": np.sqrt((err**2).mean(0)), "emulator_sd_median_m_s": np.median(sd, 0),
                         "inside_90_band": (np.abs(z) <= stats.norm.ppf(0.95)).mean(0), "mean_z2": (z**2).mean(0)},
                        index=columns).round(3).to_string())
-    d2, dof = mahalanobis(err, cov), eta.shape[1]
-    print(f"Mahalanobis distance: mean {d2.mean():.2f} (chi-square({dof}): {dof}), share beyond its 90% point "
-          f"{(d2 > stats.chi2.ppf(0.9, dof)).mean():.2f} (0.10), KS p {stats.kstest(d2, stats.chi2(dof).cdf).pvalue:.3g}")
     rng = np.random.default_rng(1)
-    chol = np.linalg.cholesky(cov)
-    print(f"with observation noise: share beyond {share_beyond_90(eta, cov, lambda: err, sd_fraction, rng):.3f}; "
-          "errors drawn from the emulator's own covariance: "
-          f"{share_beyond_90(eta, cov, lambda: np.einsum('nij,nj->ni', chol, rng.normal(size=eta.shape)), sd_fraction, rng):.3f}")
-    top = np.argsort(d2)[::-1][:5]
-    print("largest distances (run order among the usable runs: distance, worst feature, its |z|):")
-    for i in top:
-        j = np.abs(z[i]).argmax()
-        print(f"  {i}: {d2[i]:.1f}, {columns[j]}, {abs(z[i, j]):.1f}")
+    for cols, fitted in emulator.error_groups(shots):
+        e, c, f = err[:, cols], cov[:, cols[:, None], cols[None, :]], len(cols)
+        d2 = mahalanobis(e, c)
+        print(f"\nblock {'+'.join(columns[i] for i in cols[[0, -1]])} ({f} features): Mahalanobis mean {d2.mean():.2f}")
+        for label, model in [("gaussian", ErrorModel()), (f"student t (dof {fitted.dof:.2f}, scale {fitted.scale:.3f})",
+                                                          fitted)]:
+            u = distance_cdf(model, f)(d2)
+            print(f"  {label}: beyond 90% point {(u > 0.9).mean():.2f} (0.10), beyond 99% {(u > 0.99).mean():.2f} "
+                  f"(0.01), KS p {stats.kstest(u, 'uniform').pvalue:.3g}")
+            print(f"    with observation noise: beyond the 90% point of the model's own residuals "
+                  f"{share_beyond_90_with_noise(eta[:, cols], c, e, model, sd_fraction, rng):.3f} (0.10)")
+        top = np.argsort(d2)[::-1][:5]
+        print("  largest distances (run order among the usable runs: distance, worst feature, its |z|):")
+        for i in top:
+            j = cols[np.abs(z[i, cols]).argmax()]
+            print(f"    {i}: {d2[i]:.1f}, {columns[j]}, {abs(z[i, j]):.1f}")
     return 0
 
 

@@ -3,7 +3,7 @@ calibration likelihood built from it, and an emulator that carries it through sa
 
 import numpy as np
 import pytest
-from scipy import stats
+from scipy import integrate, stats
 
 from shockcal.calibration import Problem
 from shockcal.emulator import PCGPEmulator, Settings
@@ -15,22 +15,57 @@ def _spd(rng, f):
     return a @ a.T + f * np.eye(f)
 
 
-@pytest.mark.parametrize("dof", [3.0, 12.5, np.inf])
-def test_log_density_matches_scipy(dof):
+def _mixture_by_quad(resid, cov, noise_var, model):
+    """log of the integral over w of N(resid; 0, scale cov / w + diag(noise_var)) Gamma(w; dof/2,
+    rate dof/2), by scipy's adaptive quadrature in log w around the integrand's peak."""
+    mixing = stats.gamma(model.dof / 2, scale=2 / model.dof)
+
+    def log_integrand(t):
+        gauss = stats.multivariate_normal(np.zeros(len(resid)), model.scale * cov / np.exp(t) + np.diag(noise_var))
+        return gauss.logpdf(resid) + mixing.logpdf(np.exp(t)) + t
+
+    grid = np.linspace(-35, 8, 861)
+    peak_at = grid[np.argmax([log_integrand(t) for t in grid])]
+    peak = log_integrand(peak_at)
+    value, _ = integrate.quad(lambda t: np.exp(log_integrand(t) - peak), -35, 8, points=[peak_at], limit=500,
+                              epsabs=0, epsrel=1e-11)
+    return np.log(value) + peak
+
+
+@pytest.mark.parametrize("dof", [1.5, 6.0, 40.0, 900.0])
+@pytest.mark.parametrize("noise", [0.01, 1.0, 100.0])
+def test_error_plus_noise_density_matches_adaptive_quadrature(dof, noise):
+    """Residuals from typical to 100 sd out, noise from negligible to dominant: within 1e-8."""
+    rng = np.random.default_rng(int(dof * 10) + int(noise * 100))
+    cov = _spd(rng, 4)
+    noise_var = noise * np.diag(cov) * rng.uniform(0.5, 2.0, 4)
+    resid = rng.multivariate_normal(np.zeros(4), cov + np.diag(noise_var), size=5) * np.array([[0.3, 1, 3, 10, 100]]).T
+    model = ErrorModel(dof, 0.7)
+    got = model.log_density(resid, np.broadcast_to(cov, (5, 4, 4)), np.broadcast_to(noise_var, (5, 4)))
+    want = [_mixture_by_quad(r, cov, noise_var, model) for r in resid]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("dof", [3.0, np.inf])
+def test_closed_forms_match_scipy(dof):
+    """Without noise the density is scipy's multivariate t; at infinite dof a Gaussian on scale C + noise."""
     rng = np.random.default_rng(0)
-    cov, noise = _spd(rng, 4), np.diag(rng.uniform(0.5, 2.0, 4))
+    cov, noise_var = _spd(rng, 4), rng.uniform(0.5, 2.0, 4)
     resid = 3.0 * rng.normal(size=(5, 4))
-    got = ErrorModel(dof, 0.7).log_density(resid, np.broadcast_to(cov, (5, 4, 4)), np.broadcast_to(noise, (5, 4, 4)))
-    shape = 0.7 * cov + noise
-    want = (stats.multivariate_normal(np.zeros(4), shape).logpdf(resid) if np.isinf(dof)
-            else stats.multivariate_t(np.zeros(4), shape, df=dof).logpdf(resid))
+    model, covs = ErrorModel(dof, 0.7), np.broadcast_to(cov, (5, 4, 4))
+    if np.isinf(dof):
+        got = model.log_density(resid, covs, np.broadcast_to(noise_var, (5, 4)))
+        want = stats.multivariate_normal(np.zeros(4), 0.7 * cov + np.diag(noise_var)).logpdf(resid)
+    else:
+        got, want = model.log_density(resid, covs), stats.multivariate_t(np.zeros(4), 0.7 * cov, df=dof).logpdf(resid)
     np.testing.assert_allclose(got, want, rtol=1e-12)
 
 
 def test_log_density_is_nan_only_where_the_matrix_is_not_positive_definite():
-    cov = np.stack([np.eye(2), np.array([[1.0, 2.0], [2.0, 1.0]])])
-    value = ErrorModel(5.0).log_density(np.ones((2, 2)), cov)
-    assert np.isfinite(value[0]) and np.isnan(value[1])
+    cov = np.stack([np.eye(2), np.array([[1.0, 2.0], [2.0, 1.0]]), np.full((2, 2), np.nan)])
+    for noise_var in [None, np.ones((3, 2))]:
+        value = ErrorModel(5.0).log_density(np.ones((3, 2)), cov, noise_var)
+        assert np.isfinite(value[0]) and np.isnan(value[1:]).all()
 
 
 @pytest.mark.parametrize("dof", [4.0, 8.0])
@@ -68,8 +103,8 @@ def test_samples_follow_the_model():
 
 
 def test_likelihood_sums_one_density_per_error_group():
-    """Two independent groups: the Problem's log-likelihood is the sum of each group's t density of
-    its residual, with the observation noise added to the group's scale matrix."""
+    """Two independent groups: the Problem's log-likelihood is the sum of each group's density of its
+    residual (emulator error plus observation noise of variance obs_sd^2 / lambda_y)."""
     rng = np.random.default_rng(3)
     cov = _spd(rng, 4)
     cov[:2, 2:] = cov[2:, :2] = 0.0
@@ -82,12 +117,13 @@ def test_likelihood_sums_one_density_per_error_group():
     got = problem.log_likelihood(np.column_stack([np.full(6, 0.5), lam]))
     want = np.zeros(6)
     for i in range(6):
-        for cols, error in groups:
-            shape = error.scale * cov[np.ix_(cols, cols)] + np.diag((0.01 * observed[cols]) ** 2) / lam[i]
-            dist = (stats.multivariate_normal(np.zeros(2), shape) if np.isinf(error.dof)
-                    else stats.multivariate_t(np.zeros(2), shape, df=error.dof))
-            want[i] += dist.logpdf(observed[cols] - means[i, cols])
-    np.testing.assert_allclose(got, want, rtol=1e-12)
+        (t_cols, t_model), (g_cols, g_model) = groups
+        noise_var = (0.01 * observed) ** 2 / lam[i]
+        want[i] = _mixture_by_quad(observed[t_cols] - means[i, t_cols], cov[np.ix_(t_cols, t_cols)],
+                                   noise_var[t_cols], t_model)
+        want[i] += stats.multivariate_normal(np.zeros(2), 1.2 * cov[np.ix_(g_cols, g_cols)]
+                                             + np.diag(noise_var[g_cols])).logpdf(observed[g_cols] - means[i, g_cols])
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-8)
 
 
 def test_emulator_fits_the_error_model_to_its_kfold_and_keeps_it(tmp_path):

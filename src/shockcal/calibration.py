@@ -2,11 +2,11 @@
 
 For the shots calibrated together, the measured features y (m/s, four per shot) are modelled as
 
-    y - eta(theta) ~ t_nu( 0, s C_eta(theta) + Sigma_y / lambda_y ),
+    y = eta(theta) + e + eps,   e ~ t_nu(0, s C_eta(theta)),   eps ~ N(0, Sigma_y / lambda_y),
 
 eta and C_eta the emulator's predictive mean and covariance, (nu, s) its error model (a Student t
 fitted to its K-fold errors, `shockcal.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
-term per emulator block (their errors are independent), Sigma_y diagonal with sd =
+e per emulator block (their errors are independent), Sigma_y diagonal with sd =
 `observed.sd_fraction` (1%) of each measured feature, lambda_y ~ Gamma(5, 5), theta uniform on the
 prior box. The emulator's hyperparameters are fixed at their fitted mode (modular Bayes; see
 docs/calibration.md). A point is (theta in native units, lambda_y); both priors are reached from the
@@ -104,8 +104,8 @@ class Problem:
         groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
         value = np.zeros(len(points))
         for cols, error in groups:
-            noise_cov = np.diag(self.obs_sd[cols] ** 2)[None] / lam[:, None, None]
-            value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_cov)
+            noise_var = self.obs_sd[cols] ** 2 / lam[:, None]
+            value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_var)
         bad = ~np.isfinite(value)
         if bad.any():
             point = dict(zip([*self.names, "lambda_y"], points[np.argmax(bad)].tolist()))
