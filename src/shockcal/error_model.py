@@ -14,8 +14,8 @@ w ~ Gamma(dof / 2, rate dof / 2), so
     p(r) = integral over w of N(r; 0, scale C / w + Sigma_y / lambda_y) Gamma(w) dw.
 
 One eigendecomposition per point makes the integrand O(F) per w (`_mixture_log_density`); the
-integral is a trapezoid rule in log w on a fixed grid (LOG_W_GRID), within 1e-8 of
-adaptive quadrature for dof 1.5-1000 and residuals 0.3-100 times their sd (tests/test_error_model.py).
+integral is a trapezoid rule in log w (`log_w_grid`), within 1e-8 of adaptive quadrature for dof
+1.5-1000 and residuals 0.3-100 times their sd (tests/test_error_model.py).
 """
 
 from __future__ import annotations
@@ -26,10 +26,9 @@ import numpy as np
 from scipy import stats
 from scipy.special import gammaln, logsumexp
 
-FIT_MAX_DOF = 1000.0  # dof fitted above this: Gaussian (the log-w grid resolves the mixture up to here)
-LOG_W_STEP = 0.04     # trapezoid step in log w: below the mixing density's width at dof <= FIT_MAX_DOF
-LOG_W_GRID = np.arange(-30.0, 8.0 + LOG_W_STEP / 2, LOG_W_STEP)   # w from 1e-13 (outliers) to 3000
-POINTS_PER_BLOCK = 2000                                          # memory: points x grid nodes per block
+FIT_MAX_DOF = 1000.0          # dof fitted above this: Gaussian for every purpose here
+LOG_W_RANGE = (-30.0, 8.0)    # w from 1e-13 (far outliers) to 3000
+POINTS_PER_BLOCK = 2000       # memory: points x grid nodes per block
 
 
 @dataclass(frozen=True)
@@ -73,17 +72,18 @@ class ErrorModel:
         inv_sd = 1.0 / np.sqrt(noise_var)
         e, q = np.linalg.eigh(self.scale * emulator_cov * inv_sd[:, :, None] * inv_sd[:, None, :])
         rho2 = np.einsum("nij,ni->nj", q, resid * inv_sd) ** 2
-        w = np.exp(LOG_W_GRID)
+        log_w, step = log_w_grid(self.dof, resid.shape[1])
+        w = np.exp(log_w)
         d2, log_det = np.zeros((len(resid), len(w))), np.zeros((len(resid), len(w)))
         for j in range(resid.shape[1]):
             a = np.clip(e[:, j:j + 1], 0.0, None) / w + 1.0
             d2 += rho2[:, j:j + 1] / a
             log_det += np.log(a)
         half_nu = 0.5 * self.dof
-        log_prior = half_nu * np.log(half_nu) - gammaln(half_nu) + half_nu * (LOG_W_GRID - w)   # of log w
+        log_prior = half_nu * np.log(half_nu) - gammaln(half_nu) + half_nu * (log_w - w)   # of log w
         log_gauss = -0.5 * (d2 + log_det + np.log(noise_var).sum(1, keepdims=True)
                             + resid.shape[1] * np.log(2 * np.pi))
-        value = logsumexp(log_gauss + log_prior, axis=1) + np.log(LOG_W_STEP)
+        value = logsumexp(log_gauss + log_prior, axis=1) + np.log(step)
         not_psd = e[:, 0] < -1e-9 * np.abs(e[:, -1])
         return np.where(not_psd, np.nan, value)
 
@@ -115,3 +115,11 @@ def _closed_form(resid: np.ndarray, cov: np.ndarray, dof: float) -> np.ndarray:
         return -0.5 * (d2 + log_det + f * np.log(2 * np.pi))
     return (gammaln(0.5 * (dof + f)) - gammaln(0.5 * dof) - 0.5 * f * np.log(dof * np.pi) - 0.5 * log_det
             - 0.5 * (dof + f) * np.log1p(d2 / dof))
+
+
+def log_w_grid(dof: float, n_features: int) -> tuple[np.ndarray, float]:
+    """Trapezoid nodes in log w and their step. Given a residual, log w has a density of width at
+    least sqrt(2 / (dof + F)) (a Gamma of shape (dof + F) / 2 when the noise is negligible, wider
+    otherwise); a step of half that puts the trapezoid rule's error below exp(-2 pi^2 4) = 1e-34."""
+    step = 0.5 * np.sqrt(2.0 / (dof + n_features))
+    return np.arange(LOG_W_RANGE[0], LOG_W_RANGE[1] + step / 2, step), step
