@@ -298,6 +298,11 @@ class PCGPEmulator:
         sd_scale = self.scale * self.sd_factors(mean)                              # (N, F)
         return mean, z_cov * sd_scale[:, :, None] * sd_scale[:, None, :]
 
+    def error_groups(self) -> list[tuple[np.ndarray, ErrorModel]]:
+        """All outputs in one group with this emulator's error model (a calibration `Problem`'s
+        `error_groups` from a notebook)."""
+        return [(np.arange(len(self.mean)), self.error)]
+
     def switch_weight(self, mean: np.ndarray) -> np.ndarray:
         """(N, F) weight of the switched regime at predicted means: for each switch's columns a
         logistic step in mean[numerator] / mean[denominator] at `settings.switch_ratio` (width
