@@ -28,33 +28,38 @@ def density(x: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return share / width, np.sqrt(share * (1 - share) / len(x)) / width
 
 
-def test_the_a_above_800_mpa_tip_holds_about_an_eighth_of_the_mass(draws):
+def test_the_a_above_800_mpa_tip_holds_about_four_percent_of_the_mass(draws):
+    """0.037 with the Student-t emulator error (0.120 under the Gaussian one, docs/calibration.md)."""
     tip = np.mean(draws["A"] > TIP_A_MBAR)
     se = np.sqrt(tip * (1 - tip) / len(draws))
-    assert abs(tip - 0.12) < 4 * se, f"tip mass {tip:.3f}"
+    assert abs(tip - 0.037) < 4 * se, f"tip mass {tip:.3f}"
     # the tip is the small-m arm: m there is below 0.15 for most of its mass
     assert np.median(draws.loc[draws["A"] > TIP_A_MBAR, "m"]) < 0.15
 
 
 def test_n_is_bimodal(draws):
-    """A mode at n < 0.1, a dip at 0.2-0.3 and a second mode at 0.4-0.5: both peaks stand above the
-    dip by more than 4 standard errors of their difference."""
+    """A mode at n < 0.1, a dip at 0.2-0.3 and a broad second mode at 0.4-0.7: both peaks stand above
+    the dip by more than 4 standard errors of their difference."""
     d, se = density(draws["n"].to_numpy(), np.arange(0.0, 1.51, 0.1))
     low, dip, second = 0, 2, 4
     for peak in (low, second):
         assert d[peak] - d[dip] > 4 * np.hypot(se[peak], se[dip]), (peak, d.round(2))
-    assert np.argmax(d[3:7]) + 3 in (4, 5), d.round(2)  # the second mode sits at 0.4-0.6
+    assert np.argmax(d[3:8]) + 3 in (4, 5, 6), d.round(2)  # the second mode sits at 0.4-0.7
 
 
-def test_m_is_a_spike_at_zero_over_a_flat_plateau(draws):
-    """Most of m's density is in a spike below 0.1; above 0.5 it is flat (no second mode there):
-    every 0.25-wide bin of 0.5-3 lies within 4 standard errors of their mean."""
+def test_m_is_a_spike_at_zero_over_a_plateau_without_a_second_mode(draws):
+    """m's density below 0.1 stands above the plateau by more than 4 standard errors; over 0.5-3 it
+    follows a straight line (a mild rise towards the box's end, no second mode): every 0.25-wide bin
+    lies within 4 standard errors of the line fitted to them."""
     m = draws["m"].to_numpy()
-    d, _ = density(m, np.arange(0.0, 3.01, 0.1))
-    assert d[0] > 5 * np.median(d[5:])
-    plateau, se = density(m, np.arange(0.5, 3.01, 0.25))
-    assert np.all(np.abs(plateau - plateau.mean()) < 4 * se), plateau.round(3)
+    d, se = density(m, np.arange(0.0, 3.01, 0.1))
+    assert d[0] - np.median(d[5:]) > 4 * np.hypot(se[0], np.median(se[5:])), d.round(2)
+    edges = np.arange(0.5, 3.01, 0.25)
+    plateau, se = density(m, edges)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    line = np.polyval(np.polyfit(centres, plateau, 1, w=1 / se), centres)
+    assert np.all(np.abs(plateau - line) < 4 * se), plateau.round(3)
 
 
 def test_delta3_sits_at_its_lower_bound(draws):
-    assert np.mean(draws["Delta3"] < 0.04) > 0.9  # the lowest fifth of the box, 0-4 GPa
+    assert np.mean(draws["Delta3"] < 0.04) > 0.8  # the lowest fifth of the box, 0-4 GPa (0.875)
