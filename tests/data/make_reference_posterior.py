@@ -1,9 +1,11 @@
 """Write tests/data/reference_posterior_joint.parquet: 6,000 equal-weight draws of the reference
-joint posterior of the default study (our 1000-run emulator, the records' features).
+joint posterior of the default study (our 1000-run emulator with its Student-t error model, the
+records' features).
 
-The reference itself is nautilus with 2,000 live points run to a Kish ESS of 20,000 (114,200
-weighted points, 15 MB), made and kept by `benchmarks/bench_calibration.py --reference-dir
-benchmarks/out/reference_ours` (docs/calibration.md, "Reference posterior of the default study").
+The reference itself is nautilus with 2,000 live points run to a Kish ESS of 20,000, made and kept
+by `benchmarks/bench_calibration.py --only joint --replicates 0 --reference-dir
+benchmarks/out/reference_ours` (docs/calibration.md, "Reference posterior of the default study,
+Student-t emulator error").
 Systematic resampling to 6,000 rows adds almost no noise at that ESS and keeps the file small;
 `tests/test_reference_posterior.py` checks the documented shape of the posterior on it (the tip
 mass, n's two modes, m's spike over a plateau). Columns: the 11 inputs in the design table's units
