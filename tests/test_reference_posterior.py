@@ -1,5 +1,6 @@
-"""The documented shape of the default study's reference joint posterior (docs/calibration.md,
-"Reference posterior of the default study"), checked on its saved draws
+"""The documented shape of the reference joint posterior under the Student-t emulator error, on the
+paper's published features (docs/calibration.md, "Reference posterior, Student-t emulator error, the
+paper's published features"), checked on its saved draws
 (tests/data/reference_posterior_joint.parquet, made by tests/data/make_reference_posterior.py).
 
 Each claim is tested with a margin of several binomial standard errors of the 6,000 draws, so the

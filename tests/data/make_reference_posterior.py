@@ -1,11 +1,11 @@
 """Write tests/data/reference_posterior_joint.parquet: 6,000 equal-weight draws of the reference
-joint posterior of the default study (our 1000-run emulator with its Student-t error model, the
-records' features).
+joint posterior (our 1000-run emulator with its Student-t error model, the paper's published
+features).
 
 The reference itself is nautilus with 2,000 live points run to a Kish ESS of 20,000, made and kept
 by `benchmarks/bench_calibration.py --only joint --replicates 0 --reference-dir
-benchmarks/out/reference_ours` (docs/calibration.md, "Reference posterior of the default study,
-Student-t emulator error").
+benchmarks/out/reference_published_t` (docs/calibration.md, "Reference posterior, Student-t emulator
+error, the paper's published features").
 Systematic resampling to 6,000 rows adds almost no noise at that ESS and keeps the file small;
 `tests/test_reference_posterior.py` checks the documented shape of the posterior on it (the tip
 mass, n's two modes, m's spike over a plateau). Columns: the 11 inputs in the design table's units
@@ -23,7 +23,7 @@ import pandas as pd
 from shockcal.sampler import WeightedDraws
 
 REPO = Path(__file__).resolve().parents[2]
-SOURCE = REPO / "benchmarks/out/reference_ours/reference_joint.parquet"
+SOURCE = REPO / "benchmarks/out/reference_published_t/reference_joint.parquet"
 OUT = Path(__file__).with_name("reference_posterior_joint.parquet")
 N_DRAWS = 6000
 
