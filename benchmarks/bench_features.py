@@ -20,7 +20,7 @@ from scipy.stats import norm
 from threadpoolctl import threadpool_limits
 
 from shockcal.config import load_config
-from shockcal.features import extract_features, features_table
+from shockcal.features import ExtractorSettings, extract_features, features_table
 from shockcal.records import read_record
 
 REPO = Path(__file__).resolve().parents[1]
@@ -60,14 +60,14 @@ def _seconds(function) -> float:
 def main() -> None:
     config = load_config(CONFIG)
     traces = simulated_like(N_TRACES)
+    settings = ExtractorSettings.from_config(config, SHOT)
     cases = {f"{N_TRACES} simulated-like traces ({SHOT} window)":
-             (lambda: features_table(traces, config, SHOT), N_TRACES)}
+             (lambda: features_table(traces, settings), N_TRACES)}
     for shot, spec in config["observed"]["records"].items():
         t, v = read_record(REPO / spec["path"])
         cases[f"measured record {shot} ({len(t)} points)"] = (
-            lambda t=t, v=v, shot=shot: extract_features(t, v, config["shots"][shot]["analysis"],
-                                                         config["features"]), 1)
-    features_table(traces.head(1), config, SHOT)  # warm-up: imports, first fit
+            lambda t=t, v=v, shot=shot: extract_features(t, v, ExtractorSettings.from_config(config, shot)), 1)
+    features_table(traces.head(1), settings)  # warm-up: imports, first fit
     print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (timings inflated when high)")
     print(f"{'':45}{'ms/trace':>10}{'1 thread':>10}   goal {GOAL_MS:.0f}")
     for name, (function, count) in cases.items():

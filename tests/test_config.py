@@ -112,3 +112,16 @@ def test_hydro_settings_defaults_are_the_schemas():
     schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]["hydro"]["properties"]
     defaults = {k: v["default"] for k, v in schema.items() if "default" in v}
     assert {k: v for k, v in asdict(HydroSettings()).items() if k != "cell_size_um"} == defaults
+
+
+def test_extractor_settings_defaults_are_the_schemas():
+    """`ExtractorSettings()` (the notebook default) and a config that leaves the extractor out agree."""
+    from dataclasses import asdict
+
+    from shockcal.config import SCHEMA_PATH
+    from shockcal.features import ExtractorSettings
+
+    schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]
+    sections = [schema["features"], schema["shots"]["additionalProperties"]["properties"]["analysis"]]
+    defaults = {k: v["default"] for section in sections for k, v in section["properties"].items()}
+    assert asdict(ExtractorSettings()) == defaults

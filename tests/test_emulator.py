@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.emulator import CALIBRATION_FEATURES, Emulator, fit_emulator, rmse_table
+from shockcal.config import prior_bounds
+from shockcal.emulator import CALIBRATION_FEATURES, Emulator, EmulatorSpec, fit_emulator, rmse_table
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess
 
@@ -49,7 +50,7 @@ def _synthetic_study(paper_config, n=60, seed=3):
     """A design over the paper's box whose 104S features are a known function of A, B, n."""
     from shockcal.design import latin_hypercube
 
-    design = latin_hypercube(paper_config, n, seed)
+    design = latin_hypercube(prior_bounds(paper_config), n, seed)
     lo = np.array([paper_config["inputs"][k]["min"] for k in ("A", "B", "n")])
     hi = np.array([paper_config["inputs"][k]["max"] for k in ("A", "B", "n")])
     x = (design[["A", "B", "n"]].to_numpy() - lo) / (hi - lo)
@@ -62,7 +63,7 @@ def _synthetic_study(paper_config, n=60, seed=3):
 def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
     design, features, _ = _synthetic_study(paper_config, n=90)
     paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
-    emulator = fit_emulator(paper_config, design, {"104S": features})
+    emulator = fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
     table = rmse_table(emulator.cv_table())
     overall = table.iloc[-1]
     assert overall["rmse_m_s"] < 3 * NOISE
@@ -77,7 +78,8 @@ def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
 def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path, paper_config):
     design, features, _ = _synthetic_study(paper_config, n=30)
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
-    emulator = fit_emulator(paper_config, design, {"104S": features, "106S": features})
+    emulator = fit_emulator(design, {"104S": features, "106S": features},
+                            EmulatorSpec.from_config(paper_config, ["104S", "106S"]))
     loaded = Emulator.load(emulator.save(tmp_path / "emu"))
     inputs = {k: design[k].to_numpy()[:5] for k in design.columns}
     for a, b in zip(emulator.predict(inputs, ["106S", "104S"]), loaded.predict(inputs, ["106S", "104S"])):
@@ -98,7 +100,7 @@ def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
     features.loc[0, "status"] = "failed"
     features.loc[1, "v_plastic"] = np.nan
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
-    emulator = fit_emulator(paper_config, design, {"104S": features})
+    emulator = fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
     assert len(emulator.blocks[0].runs) == 28
     assert "2 of 30 runs dropped" in caplog.text
 
@@ -112,7 +114,7 @@ def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
 def test_bad_training_sets_are_rejected(paper_config, mutate, message):
     design, features = mutate(*_synthetic_study(paper_config, n=30)[:2])
     with pytest.raises(InputError, match=message):
-        fit_emulator(paper_config, design, {"104S": features})
+        fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
 
 
 def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):

@@ -156,21 +156,23 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
     import yaml
 
     from shockcal.cli import main
+    from shockcal.config import prior_bounds
     from shockcal.design import latin_hypercube
-    from shockcal.emulator import CALIBRATION_FEATURES, Emulator, fit_emulator
+    from shockcal.emulator import CALIBRATION_FEATURES, Emulator, EmulatorSpec, fit_emulator
 
-    design = latin_hypercube(paper_config, 30, 1)
+    design = latin_hypercube(prior_bounds(paper_config), 30, 1)
     features = pd.DataFrame({f: 100 + 50 * design["A"] / 0.01 + 10 * i + 1e3 * design["V1"]
                              for i, f in enumerate(CALIBRATION_FEATURES)}).assign(run=design["run"])
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
-    emulator = fit_emulator(paper_config, design, {"104S": features, "105S": features})
+    emulator = fit_emulator(design, {"104S": features, "105S": features},
+                            EmulatorSpec.from_config(paper_config, ["104S", "105S"]))
     input_map = emulator.blocks[0].input_map
     strain, temperature = (paper_config["emulator"][k] for k in ("hardening_strain", "homologous_temperature"))
     np.testing.assert_allclose(input_map.raw(design)[:, -2:], np.column_stack([strain ** design["n"],
                                                                                temperature ** design["m"]]))
     assert np.all((input_map.scaled(design) >= 0) & (input_map.scaled(design) <= 1))
     emulator.save(tmp_path / "emu")
-    new = latin_hypercube(paper_config, 7, 2).assign(run=lambda d: d["run"] + 100)
+    new = latin_hypercube(prior_bounds(paper_config), 7, 2).assign(run=lambda d: d["run"] + 100)
     new.to_csv(tmp_path / "new.csv", index=False)
     (tmp_path / "c.yaml").write_text(yaml.safe_dump(paper_config))
     assert main(["emulate-predict", "--config", str(tmp_path / "c.yaml"), "--emulator", str(tmp_path / "emu"),

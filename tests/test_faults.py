@@ -18,8 +18,8 @@ import yaml
 
 from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.cli import main, parse_pairs, parse_span
-from shockcal.config import load_config, validate_config
-from shockcal.design import latin_hypercube, load_design, validate_shot_parameters
+from shockcal.config import load_config, prior_bounds, validate_config
+from shockcal.design import ShotMapping, latin_hypercube, load_design
 from shockcal.error_model import ErrorModel
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.features import check_failures
@@ -34,7 +34,7 @@ CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 
 def _design(tmp, config, mutate, name="design.csv"):
     path = tmp / name
-    mutate(latin_hypercube(config, 5, seed=1)).to_csv(path, index=False)
+    mutate(latin_hypercube(prior_bounds(config), 5, seed=1)).to_csv(path, index=False)
     return path
 
 
@@ -72,9 +72,9 @@ def test_design_unreadable_and_non_positive_velocity(tmp_path, paper_config):
     path.write_bytes(os.urandom(2000))
     with pytest.raises(InputError, match=f"table {path} could not be read"):
         load_design(path, paper_config)
-    design = latin_hypercube(paper_config, 3, seed=1).assign(V2=0.0)
+    design = latin_hypercube(prior_bounds(paper_config), 3, seed=1).assign(V2=0.0)
     with pytest.raises(InputError, match="d.csv: run 0: impact velocity V2 = 0.0 must be positive for shot 105S"):
-        validate_shot_parameters(design, paper_config, "105S", "d.csv")
+        ShotMapping.from_config(paper_config, "105S").check_positive(design, "d.csv")
 
 
 def test_design_file_in_config_is_checked_at_load(tmp_path, paper_config):

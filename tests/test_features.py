@@ -12,6 +12,7 @@ from scipy.stats import norm
 from shockcal.errors import InputError
 from shockcal.features import (
     COLUMNS,
+    ExtractorSettings,
     Mixture,
     extract_features,
     feature_values,
@@ -71,11 +72,11 @@ GRID_STEP = 0.0005
 
 @pytest.fixture
 def settings(paper_config):
-    return paper_config["shots"][SHOT]["analysis"], paper_config["features"]
+    return ExtractorSettings.from_config(paper_config, SHOT)
 
 
 def features(v, settings):
-    return extract_features(T, v, *settings)
+    return extract_features(T, v, settings)
 
 
 def test_known_answers_of_a_two_step_trace(settings):
@@ -97,7 +98,7 @@ def test_a_weak_precursor_of_a_trace_at_rest_is_the_arrival(paper_config):
     the 2% arrival level a noisy record needs. A trace exactly at rest before it (a simulation)
     takes the precursor as the arrival, so the elastic plateau is the precursor, not the wave."""
     v = 6.0 * norm.cdf((T - 0.90) / 0.004) + 464.0 * norm.cdf((T - 1.00) / 0.01)
-    f = extract_features(T, v, paper_config["shots"]["106S"]["analysis"], paper_config["features"])
+    f = extract_features(T, v, ExtractorSettings.from_config(paper_config, "106S"))
     assert f["t_jumpoff"] == pytest.approx(0.90 + 0.004 * norm.ppf(0.01), abs=1e-3)
     assert f["v_elastic"] == pytest.approx(6.0 * 0.99, abs=0.1)
     assert f["v_plastic"] > 460
@@ -157,7 +158,8 @@ def test_neighbouring_hydrocode_runs_have_neighbouring_features(paper_config):
     shot = paper_config["shots"]["106S"]
     runs = [run_shot(ShotParameters(0.0035, 0.004, C, 0.3, 1.0, 0.0484, 0.33), *hydro_inputs(paper_config, shot))
             for C in (0.0010, 0.0011)]
-    first, second = (extract_features(r.t_us, r.v_m_s, shot["analysis"], paper_config["features"]) for r in runs)
+    settings = ExtractorSettings.from_config(paper_config, "106S")
+    first, second = (extract_features(r.t_us, r.v_m_s, settings) for r in runs)
     for column in ("v_elastic", "v_slope1", "v_slope2", "v_plastic"):
         assert abs(first[column] - second[column]) < 0.5, column
 
@@ -252,7 +254,7 @@ def test_record_with_unnamed_columns_asks_for_names(tmp_path):
 def test_record_without_a_rise_names_the_file(tmp_path, paper_config):
     path = write_trace(tmp_path / "flat.csv", ["t_us,v_m_s"], [[t, 1.5] for t in T])
     with pytest.raises(InputError, match=re.escape(f"record {path}: no features for shot {SHOT}: no rise")):
-        record_features(paper_config, SHOT, path)
+        record_features(path, ExtractorSettings.from_config(paper_config, SHOT), SHOT)
 
 
 def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config):
@@ -265,7 +267,8 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
         "t_us": [T, T, T, T, np.array([])],
         "v_m_s": [trace(noise_sd=1.0), trace(), np.zeros(T.size), broken, np.array([])],
     })
-    table = features_table(traces, paper_config, SHOT)
+    settings = ExtractorSettings.from_config(paper_config, SHOT)
+    table = features_table(traces, settings)
     assert list(table.columns) == ["run", "status", "reason", *COLUMNS]
     assert table["run"].tolist() == [0, 1, 2, 3, 4]
     assert table["status"].tolist() == ["ok", "failed", "failed", "ok", "failed"]
@@ -275,8 +278,7 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
     assert table.loc[table["status"] == "ok", COLUMNS].notna().all().all()
     assert table.loc[table["status"] != "ok", COLUMNS].isna().all().all()
     # a run's features do not depend on its position in the batch
-    expected = extract_features(T, trace(noise_sd=1.0), paper_config["shots"][SHOT]["analysis"],
-                                paper_config["features"])
+    expected = extract_features(T, trace(noise_sd=1.0), settings)
     assert table.loc[3, COLUMNS].to_dict() == expected
 
 
@@ -310,8 +312,9 @@ def record_cases():
 def record_differences(paper_config_readonly):
     published = pd.read_csv(DATA / "observed_features.csv").set_index("shot")
     return {shot: {column: value - published.loc[shot, column]
-                   for column, value in record_features(paper_config_readonly, shot,
-                                                        DATA / "visar" / f"Data_S{shot}.txt").items()}
+                   for column, value in record_features(DATA / "visar" / f"Data_S{shot}.txt",
+                                                        ExtractorSettings.from_config(paper_config_readonly, shot),
+                                                        shot).items()}
             for shot in BOUNDS}
 
 

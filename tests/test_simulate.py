@@ -7,8 +7,9 @@ import yaml
 
 from shockcal import hydro
 from shockcal.cli import main
-from shockcal.design import latin_hypercube
-from shockcal.simulate import simulate_design
+from shockcal.config import prior_bounds
+from shockcal.design import ShotMapping, latin_hypercube
+from shockcal.simulate import hydro_inputs, simulate_design
 
 
 @pytest.fixture
@@ -21,8 +22,8 @@ def coarse_config(paper_config, tmp_path):
 
 def test_table_has_documented_columns(coarse_config):
     config, _ = coarse_config
-    design = latin_hypercube(config, 2, seed=1)
-    table = simulate_design(design, config, "105S")
+    design = latin_hypercube(prior_bounds(config), 2, seed=1)
+    table = simulate_design(design, ShotMapping.from_config(config, "105S"), *hydro_inputs(config, config["shots"]["105S"]))
     expected = {"run", "shot", "A", "B", "C", "n", "m", "V2", "G1", "Delta2", "impact_velocity_m_s", "shear_modulus_GPa",
                 "status", "reason", "max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
                 "n_steps", "wall_time_s", "t_us", "v_m_s"}
@@ -41,9 +42,9 @@ def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypa
             raise FloatingPointError("synthetic failure")
         return real(params, *inputs)
 
-    design = latin_hypercube(config, 3, seed=2)
+    design = latin_hypercube(prior_bounds(config), 3, seed=2)
     monkeypatch.setattr("shockcal.simulate.run_shot", flaky)
-    table = simulate_design(design, config, "104S")
+    table = simulate_design(design, ShotMapping.from_config(config, "104S"), *hydro_inputs(config, config["shots"]["104S"]))
     assert list(table["status"]) == ["ok", "failed", "ok"]
     assert "synthetic failure" in table["reason"].iloc[1]
     assert np.isnan(table["max_temperature_K"].iloc[1])
@@ -51,7 +52,7 @@ def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypa
 
 def test_cli_writes_the_slice_and_is_deterministic(coarse_config, tmp_path):
     config, path = coarse_config
-    latin_hypercube(config, 4, seed=3).to_csv(tmp_path / "d.csv", index=False)
+    latin_hypercube(prior_bounds(config), 4, seed=3).to_csv(tmp_path / "d.csv", index=False)
     for name in ("a", "b"):
         assert main(["simulate", "--config", str(path), "--shot", "106S", "--design", str(tmp_path / "d.csv"),
                      "--rows", "1:3", "--out", str(tmp_path / f"{name}.parquet")]) == 0
@@ -63,7 +64,7 @@ def test_cli_writes_the_slice_and_is_deterministic(coarse_config, tmp_path):
 
 def test_bad_design_is_rejected_before_any_run(coarse_config, tmp_path, capsys):
     config, path = coarse_config
-    design = latin_hypercube(config, 3, seed=4)
+    design = latin_hypercube(prior_bounds(config), 3, seed=4)
     design.loc[2, "n"] = -0.1
     design.to_csv(tmp_path / "bad.csv", index=False)
     assert main(["simulate", "--config", str(path), "--shot", "104S", "--design", str(tmp_path / "bad.csv"),

@@ -438,15 +438,3 @@ def binomial_band(trials):
     """The central 95% band of the share of `trials` (a count or an array of counts) that a
     calibrated 90% interval covers."""
     return stats.binom.ppf(0.025, trials, 0.9) / trials, stats.binom.ppf(0.975, trials, 0.9) / trials
-
-
-def coverage_check(emulator, shots, config: dict, trials: int | range | None = None,
-                   truths: HydroTruths | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The configured synthetic-truth check (calibration.check), on emulator or hydrocode truth:
-    per-trial table and coverage per parameter. `trials`: a count or the trial numbers of one batch
-    (default: all `calibration.check.trials`)."""
-    truth = "emulator" if truths is None else "hydrocode"
-    table = synthetic_truth(emulator, shots, CalibrationSettings.from_config(config, shots, check=True),
-                            trials or config["calibration"]["check"]["trials"],
-                            seed=stream_seed(config["study"]["seed"], "check", truth, *shots), truths=truths)
-    return table, coverage_table(table)

@@ -167,22 +167,11 @@ def end_time_us(config: dict, shot: dict) -> float:
     return shot["target_mm"] * MM_TO_CM / c0_cm_us + window + AUTO_END_MARGIN_US
 
 
-def shot_inputs(config: dict, shot: str) -> list[str]:
-    """Design columns one shot depends on: A, B, C, n, m, its velocity, its shear-modulus terms."""
-    spec = shot_config(config, shot)
-    return [*STRENGTH_INPUTS, spec["velocity_input"], *spec["shear_modulus_inputs"]]
-
-
 def input_names(config: dict) -> list[str]:
     """All calibration inputs in config order (the design table's columns)."""
     return list(config["inputs"])
 
 
-def input_bounds(config: dict, names: list[str] | None = None):
-    """(lower, upper) arrays of the prior box for `names` (default: all inputs), native units."""
-    import numpy as np
-
-    names = input_names(config) if names is None else names
-    lower = np.array([config["inputs"][k]["min"] for k in names], dtype=float)
-    upper = np.array([config["inputs"][k]["max"] for k in names], dtype=float)
-    return lower, upper
+def prior_bounds(config: dict) -> dict[str, tuple[float, float]]:
+    """The prior box, input by input in config order: name -> (min, max) in the box's native units."""
+    return {name: (box["min"], box["max"]) for name, box in config["inputs"].items()}

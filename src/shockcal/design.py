@@ -3,19 +3,20 @@
 A design table has one row per run: an integer `run` id and one column per calibration input
 (A, B, C, n, m, V1, V2, V3, G1, Delta2, Delta3 for the paper's study) in the box's native units
 (Mbar for A, B and shear moduli; cm/us for velocities; C, n, m dimensionless). One design serves
-every shot: `shot_parameters` maps a row onto one shot (SPEC section 3).
+every shot: a `ShotMapping` maps a row onto one shot (SPEC section 3).
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from shockcal.config import STRENGTH_INPUTS, input_bounds, input_names, shot_config
+from shockcal.config import STRENGTH_INPUTS, input_names, prior_bounds, shot_config
 from shockcal.errors import InputError
 from shockcal.io import read_table, require_columns
 from shockcal.plausibility import range_problem
@@ -24,19 +25,19 @@ from shockcal.seeds import stream_seed
 log = logging.getLogger("shockcal.design")
 
 
-def latin_hypercube(config: dict, n_runs: int, seed: int) -> pd.DataFrame:
-    """A seeded Latin hypercube of `n_runs` points over the config's input box (scipy.stats.qmc).
+def latin_hypercube(bounds: Mapping[str, tuple[float, float]], n_runs: int, seed: int) -> pd.DataFrame:
+    """A seeded Latin hypercube of `n_runs` points over a box (input -> (min, max); scipy.stats.qmc).
 
-    The hypercube's dimensions are the inputs in sorted order, so the design depends on the inputs
-    and the seed, not on the order the config lists them (the workflow's jobs read a key-sorted
-    copy of the config); the columns come back in config order.
+    The hypercube's dimensions are the inputs in sorted order, so the design depends on the box and
+    the seed, not on the order the box lists its inputs (the workflow's jobs read a key-sorted copy
+    of the config); the columns come back in the box's order.
     """
     from scipy.stats import qmc
 
-    names = sorted(input_names(config))
-    lower, upper = input_bounds(config, names)
+    names = sorted(bounds)
+    lower, upper = np.array([bounds[name] for name in names], dtype=float).T
     unit = qmc.LatinHypercube(d=len(names), seed=np.random.default_rng(seed)).random(n_runs)
-    design = pd.DataFrame(qmc.scale(unit, lower, upper), columns=names)[input_names(config)]
+    design = pd.DataFrame(qmc.scale(unit, lower, upper), columns=names)[list(bounds)]
     design.insert(0, "run", np.arange(n_runs, dtype=np.int64))
     return design
 
@@ -46,7 +47,7 @@ def load_design(path: str | Path, config: dict, columns: list[str] | None = None
 
     `columns` are the inputs that must be present (default: all config inputs). Values must be
     finite; Johnson-Cook inputs non-negative; inside the prior box (`check_design_box`); velocities
-    and shear moduli positive (checked per shot by `validate_shot_parameters`). Errors name the
+    and shear moduli positive (checked per shot by `ShotMapping.check_positive`). Errors name the
     file, the row and the parameter.
     """
     design = read_table(path)
@@ -105,27 +106,41 @@ class ShotParameters:
     shear_modulus_Mbar: float
 
 
-def shot_parameters(row, config: dict, shot: str) -> ShotParameters:
-    """Map one design row onto a shot: its velocity input and G = sum of its shear-modulus inputs."""
-    spec = shot_config(config, shot)
-    return ShotParameters(
-        *(float(row[k]) for k in STRENGTH_INPUTS),
-        velocity_cm_us=float(row[spec["velocity_input"]]),
-        shear_modulus_Mbar=float(sum(row[k] for k in spec["shear_modulus_inputs"])),
-    )
+@dataclass(frozen=True)
+class ShotMapping:
+    """How one shot reads a design row (SPEC section 3): the input that is its impact velocity, and
+    the inputs whose sum is its shear modulus (the Johnson-Cook inputs are every shot's)."""
 
+    shot: str
+    velocity_input: str
+    shear_modulus_inputs: tuple[str, ...]
 
-def validate_shot_parameters(design: pd.DataFrame, config: dict, shot: str, source: str | Path) -> None:
-    """Reject rows whose shot velocity or shear modulus is not positive, before any run starts."""
-    spec = shot_config(config, shot)
-    velocity = design[spec["velocity_input"]].to_numpy(dtype=float)
-    shear = design[spec["shear_modulus_inputs"]].to_numpy(dtype=float).sum(axis=1)
-    for label, values in ((f"impact velocity {spec['velocity_input']}", velocity),
-                          (f"shear modulus {'+'.join(spec['shear_modulus_inputs'])}", shear)):
-        bad = values <= 0
-        if bad.any():
-            row = design.loc[bad, "run"].iloc[0]
-            raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {shot}")
+    @classmethod
+    def from_config(cls, config: dict, shot: str) -> ShotMapping:
+        """From a validated config's `shots.<shot>` section (a ConfigError names an unknown shot)."""
+        spec = shot_config(config, shot)
+        return cls(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
+
+    def inputs(self) -> list[str]:
+        """The design columns the shot depends on: A, B, C, n, m, its velocity, its shear-modulus terms."""
+        return [*STRENGTH_INPUTS, self.velocity_input, *self.shear_modulus_inputs]
+
+    def parameters(self, row) -> ShotParameters:
+        """One design row (a mapping of input name to value) as this shot's hydrocode inputs."""
+        return ShotParameters(*(float(row[k]) for k in STRENGTH_INPUTS),
+                              velocity_cm_us=float(row[self.velocity_input]),
+                              shear_modulus_Mbar=float(sum(row[k] for k in self.shear_modulus_inputs)))
+
+    def check_positive(self, design: pd.DataFrame, source: str | Path) -> None:
+        """Reject rows whose velocity or shear modulus is not positive for this shot, before any run starts."""
+        velocity = design[self.velocity_input].to_numpy(dtype=float)
+        shear = design[list(self.shear_modulus_inputs)].to_numpy(dtype=float).sum(axis=1)
+        for label, values in ((f"impact velocity {self.velocity_input}", velocity),
+                              (f"shear modulus {'+'.join(self.shear_modulus_inputs)}", shear)):
+            bad = values <= 0
+            if bad.any():
+                row = design.loc[bad, "run"].iloc[0]
+                raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {self.shot}")
 
 
 def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
@@ -137,7 +152,7 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
         design = load_design(config["design"]["file"], config)
         return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
     seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
-    return latin_hypercube(config, n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
+    return latin_hypercube(prior_bounds(config), n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
 
 
 def write_design(design: pd.DataFrame, source: str, config: dict, path: str | Path) -> bool:

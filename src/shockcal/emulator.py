@@ -7,7 +7,7 @@ and covariance of the outputs, adding the covariance of what the truncated basis
 output's sd scaled by a factor calibrated by K-fold. Cross-validation: closed-form LOO (diagnostic),
 K-fold and the outer check (everything refitted).
 
-The study's `Emulator` (from `fit_emulator`) maps design columns to emulator inputs, in one of two
+The study's `Emulator` (from `fit_emulator`, on an `EmulatorSpec`) maps design columns to emulator inputs, in one of two
 structures (config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
@@ -22,8 +22,9 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from functools import cache
 from pathlib import Path
 
@@ -33,7 +34,8 @@ from joblib import Parallel, delayed
 from scipy.special import expit
 from threadpoolctl import ThreadpoolController, threadpool_limits
 
-from shockcal.config import STRENGTH_INPUTS, shot_config
+from shockcal.config import STRENGTH_INPUTS, prior_bounds
+from shockcal.design import ShotMapping
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
@@ -87,33 +89,27 @@ class InputMap:
                    [(float(b), str(c)) for b, c in d["powers"]])
 
 
-def shot_input_map(config: dict, shot: str) -> InputMap:
-    """A per-shot emulator's inputs: A, B, C, n, m, the shot's velocity, its summed shear modulus."""
-    spec = shot_config(config, shot)
-    terms = [[k] for k in STRENGTH_INPUTS] + [[spec["velocity_input"]], list(spec["shear_modulus_inputs"])]
-    names = [*STRENGTH_INPUTS, spec["velocity_input"], f"G_{shot}"]
-    return _box_map(config, names, terms)
+def shot_input_map(shot: ShotMapping, bounds: Mapping[str, tuple[float, float]], powers=()) -> InputMap:
+    """A per-shot emulator's inputs: A, B, C, n, m, the shot's velocity, its summed shear modulus,
+    then the `powers` (base, design column); `bounds`: the prior box by design input."""
+    terms = [[k] for k in STRENGTH_INPUTS] + [[shot.velocity_input], list(shot.shear_modulus_inputs)]
+    names = [*STRENGTH_INPUTS, shot.velocity_input, f"G_{shot.shot}"]
+    return _box_map(bounds, names, terms, powers)
 
 
-def joint_input_map(config: dict, shots: list[str]) -> InputMap:
-    """The joint emulator's inputs: every design input the shots use, each on its own."""
-    used = list(dict.fromkeys(k for shot in shots for k in _shot_terms(config, shot)))
-    return _box_map(config, used, [[k] for k in used])
+def joint_input_map(shots: list[ShotMapping], bounds: Mapping[str, tuple[float, float]], powers=()) -> InputMap:
+    """The joint emulator's inputs: every design input the shots use, each on its own, then the `powers`."""
+    used = list(dict.fromkeys(k for shot in shots for k in shot.inputs()))
+    return _box_map(bounds, used, [[k] for k in used], powers)
 
 
-def _shot_terms(config, shot):
-    spec = shot_config(config, shot)
-    return [*STRENGTH_INPUTS, spec["velocity_input"], *spec["shear_modulus_inputs"]]
-
-
-def _box_map(config, names, terms) -> InputMap:
-    lower = [sum(config["inputs"][t]["min"] for t in ts) for ts in terms]
-    upper = [sum(config["inputs"][t]["max"] for t in ts) for ts in terms]
-    powers = [(config["emulator"][key], column) for key, column in POWER_INPUTS if config["emulator"][key]]
+def _box_map(bounds, names, terms, powers) -> InputMap:
+    lower = [sum(bounds[t][0] for t in ts) for ts in terms]
+    upper = [sum(bounds[t][1] for t in ts) for ts in terms]
     for base, column in powers:             # base < 1: base^column falls as the column grows
-        lower.append(base ** config["inputs"][column]["max"])
-        upper.append(base ** config["inputs"][column]["min"])
-    return InputMap(names, terms, np.array(lower), np.array(upper), powers)
+        lower.append(base ** bounds[column][1])
+        upper.append(base ** bounds[column][0])
+    return InputMap(names, terms, np.array(lower), np.array(upper), list(powers))
 
 
 @dataclass
@@ -138,6 +134,27 @@ class Settings:
         keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd",
                 "cv_warm_start", "switch_ratio", "error_tails")
         return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
+
+
+@dataclass(frozen=True)
+class EmulatorSpec:
+    """What the study's emulator is fitted over: its structure (`per_shot` or `joint`), how each shot
+    reads the design, the prior box by design input (native units), the extra power inputs (base,
+    design column; `InputMap`) and the GP settings, whose seed keys each block's own random stream."""
+
+    structure: str
+    shots: Mapping[str, ShotMapping]
+    bounds: Mapping[str, tuple[float, float]]
+    powers: tuple[tuple[float, str], ...] = ()
+    settings: Settings = field(default_factory=Settings)
+
+    @classmethod
+    def from_config(cls, config: dict, shots) -> EmulatorSpec:
+        """The adapter from a validated config (`emulator`, `inputs`, `shots`, study.seed) for `shots`."""
+        section = config["emulator"]
+        powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key])
+        return cls(section["structure"], {s: ShotMapping.from_config(config, s) for s in shots}, prior_bounds(config),
+                   powers, Settings.from_config(section, config["study"]["seed"]))
 
 
 @dataclass
@@ -637,34 +654,34 @@ def _check_training_inputs(table: pd.DataFrame, input_map: InputMap, label: str)
                          f"the prior box [{input_map.lower[col]}, {input_map.upper[col]}]")
 
 
-def fit_emulator(config: dict, design: pd.DataFrame, features: dict[str, pd.DataFrame],
+def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: EmulatorSpec,
                  sources: dict[str, str] | None = None) -> Emulator:
-    """Fit the configured emulator structure to design + per-shot feature tables."""
+    """Fit the study's emulator to a design (Table IV units) and per-shot feature tables (m/s, us),
+    joined on `run`; block i fits with stream ("emulator", i) of `spec.settings.seed`."""
     shots = list(features)
+    mappings = [spec.shots[shot] for shot in shots]
     sources = sources or {shot: f"features of {shot}" for shot in shots}
     tables = {shot: training_data(design, features[shot], shot, sources[shot]) for shot in shots}
-    structure = config["emulator"]["structure"]
-    if structure == "per_shot":
-        groups = [([shot], shot_input_map(config, shot), tables[shot], sources[shot], CALIBRATION_FEATURES)
-                  for shot in shots]
+    if spec.structure == "per_shot":
+        groups = [([m.shot], shot_input_map(m, spec.bounds, spec.powers), tables[m.shot], sources[m.shot],
+                   CALIBRATION_FEATURES) for m in mappings]
     else:
         joined = tables[shots[0]].rename(columns={f: f"{shots[0]}:{f}" for f in CALIBRATION_FEATURES})
         for shot in shots[1:]:
             joined = joined.merge(tables[shot][["run", *CALIBRATION_FEATURES]].rename(
                 columns={f: f"{shot}:{f}" for f in CALIBRATION_FEATURES}), on="run", how="inner")
-        groups = [(shots, joint_input_map(config, shots), joined, "joint training set",
+        groups = [(shots, joint_input_map(mappings, spec.bounds, spec.powers), joined, "joint training set",
                    [f"{s}:{f}" for s in shots for f in CALIBRATION_FEATURES])]
     blocks = []
     for i, (block_shots, input_map, table, label, columns) in enumerate(groups):
         _check_training_inputs(table, input_map, label)
-        settings = Settings.from_config(config["emulator"], stream_seed(config["study"]["seed"], "emulator", i))
+        settings = replace(spec.settings, seed=stream_seed(spec.settings.seed, "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
                                  settings, switches=single_wave_switches(len(block_shots)))
         log.info("emulator %s: %d runs, %d inputs, %d of %d components, %s correlation", "+".join(block_shots),
                  len(table), len(input_map.names), len(model.gps), len(columns), settings.family)
         blocks.append(Block(input_map, block_shots, table["run"].to_numpy(), model))
-    bounds = {k: (v["min"], v["max"]) for k, v in config["inputs"].items()}
-    return Emulator(structure, blocks, bounds, {s: _shot_terms(config, s) for s in shots})
+    return Emulator(spec.structure, blocks, dict(spec.bounds), {m.shot: m.inputs() for m in mappings})
 
 
 def single_wave_switches(n_shots: int) -> list[Switch]:

@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import optimize, stats
 
+from shockcal.config import shot_config
 from shockcal.errors import InputError, ShockcalError
 
 if TYPE_CHECKING:
@@ -120,24 +121,41 @@ def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
     return float(t[np.argmax(v - baseline > threshold)])
 
 
-def extract(t, v, window_after_arrival_us: float, cutoff_after_arrival_us: float, n_components: int = 5,
-            n_samples: int = 10000) -> Extraction:
+@dataclass(frozen=True)
+class ExtractorSettings:
+    """How one shot's traces are read: the analysis window and the elastic cut-off after the arrival
+    (us; config `shots.<shot>.analysis`), the mixture's components and PIT samples (config `features`).
+    The defaults are the config schema's (a test keeps them equal)."""
+
+    window_after_arrival_us: float = 1.2
+    cutoff_after_arrival_us: float = 0.04
+    n_components: int = 5
+    n_samples: int = 10000
+
+    @classmethod
+    def from_config(cls, config: dict, shot: str) -> ExtractorSettings:
+        """From a validated config's `shots.<shot>.analysis` and `features` sections."""
+        return cls(**shot_config(config, shot)["analysis"], **config["features"])
+
+
+def extract(t, v, settings: ExtractorSettings = ExtractorSettings()) -> Extraction:
     """Run the extractor on one trace (t in us, v in m/s); raises FeatureError when it cannot."""
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
     bad = ~(np.isfinite(t) & np.isfinite(v))
     if bad.any():
         raise FeatureError(f"{int(bad.sum())} non-finite values in the trace (first at index {int(np.argmax(bad))})")
     arrival = detect_arrival(t, v)
-    start, end = arrival - PRE_ARRIVAL_US, arrival + window_after_arrival_us
+    start, end = arrival - PRE_ARRIVAL_US, arrival + settings.window_after_arrival_us
     if end > t[-1]:
         raise FeatureError(f"trace ends at {t[-1]:.3f} us, before the analysis window ({end:.3f} us)")
     inside = (t >= start) & (t <= end)
     tw, vw = t[inside], v[inside]
     y = np.maximum.accumulate((vw - vw.min()) / (vw.max() - vw.min()))
     rising = np.diff(y, prepend=-1.0) > 0
-    samples = np.interp((np.arange(n_samples) + 0.5) / n_samples, y[rising], tw[rising])
-    mixture = fit_mixture(samples, n_components)
-    cutoff = arrival + cutoff_after_arrival_us
+    n = settings.n_samples
+    samples = np.interp((np.arange(n) + 0.5) / n, y[rising], tw[rising])
+    mixture = fit_mixture(samples, settings.n_components)
+    cutoff = arrival + settings.cutoff_after_arrival_us
     early = split_early(mixture, cutoff)
     features = feature_values(t, v, tw, y, mixture, early, cutoff)
     return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
@@ -201,27 +219,26 @@ def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
     return Mixture(best.weights_, centre + spread * best.means_.ravel(), spread * np.sqrt(best.covariances_.ravel()))
 
 
-def extract_features(t, v, analysis: dict, settings: dict) -> dict:
-    """The ten feature values of a trace with the config's per-shot analysis and features settings."""
-    return extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
-                   settings["n_components"], settings["n_samples"]).features
+def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) -> dict:
+    """The ten feature values of a trace (t in us, v in m/s)."""
+    return extract(t, v, settings).features
 
 
-def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
-    """One row per simulated run: run, status, reason and the ten features.
+def features_table(traces, settings: ExtractorSettings) -> pd.DataFrame:
+    """One row per simulated run (a simulations table: run, status, reason, t_us, v_m_s): run, status,
+    reason and the ten features.
 
     Failed simulations keep their status and reason; a trace the extractor cannot read becomes
     status "failed" with the extractor's reason.
     """
     import pandas as pd
 
-    analysis, settings = config["shots"][shot]["analysis"], config["features"]
     rows = []
     for record in traces.to_dict("records"):
         row = {"run": int(record["run"]), "status": record["status"], "reason": record["reason"]}
         if record["status"] == "ok":
             try:
-                row.update(extract_features(record["t_us"], record["v_m_s"], analysis, settings))
+                row.update(extract_features(record["t_us"], record["v_m_s"], settings))
             except FeatureError as exc:
                 row.update(status="failed", reason=f"feature extraction: {exc}")
         rows.append(row)
@@ -231,14 +248,14 @@ def features_table(traces, config: dict, shot: str) -> pd.DataFrame:
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
 
 
-def record_features(config, shot, path, time_column=None, velocity_column=None) -> dict:
-    """The ten features of a measured record, with the shot's analysis settings; InputError naming the
-    record when it has none."""
+def record_features(path, settings: ExtractorSettings, shot: str, time_column=None, velocity_column=None) -> dict:
+    """The ten features of a measured record (`shockcal.records.read_record`) of `shot`; an InputError
+    naming the record and the shot when it has none."""
     from shockcal.records import read_record
 
     t, v = read_record(path, _column(time_column), _column(velocity_column))
     try:
-        return extract_features(t, v, config["shots"][shot]["analysis"], config["features"])
+        return extract_features(t, v, settings)
     except FeatureError as exc:
         raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
 
@@ -271,7 +288,8 @@ def observed_table(config: dict):
         if observed["source"] == "records":
             spec = observed["records"][shot]
             rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
-                         **record_features(config, shot, spec["path"], spec["time_column"], spec["velocity_column"])})
+                         **record_features(spec["path"], ExtractorSettings.from_config(config, shot), shot,
+                                              spec["time_column"], spec["velocity_column"])})
         else:
             rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
                          **observed["features"][shot]})

@@ -14,8 +14,8 @@ import logging
 import numpy as np
 import pandas as pd
 
-from shockcal.config import end_time_us, shot_config, shot_inputs
-from shockcal.design import shot_parameters
+from shockcal.config import end_time_us
+from shockcal.design import ShotMapping
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
@@ -35,14 +35,14 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None):
             MaterialProperties.from_config(config["material"]), HydroSettings.from_config(config["hydro"]))
 
 
-def simulate_design(design: pd.DataFrame, config: dict, shot: str, end_us: float | None = None) -> pd.DataFrame:
-    """Simulate every row of `design` for `shot` to `end_us` (default: the config's end time for the
-    shot, `hydro.end_time_us`); failures become rows with a reason."""
-    geometry, material, settings = hydro_inputs(config, shot_config(config, shot), end_us)
-    inputs = shot_inputs(config, shot)
+def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geometry, material: MaterialProperties,
+                    settings: HydroSettings) -> pd.DataFrame:
+    """Simulate every row of `design` (Table IV units) for the shot `mapping` reads it as, to
+    `geometry.end_us`; failures become rows with a reason. From a config: `ShotMapping.from_config` and `hydro_inputs`."""
+    shot, inputs = mapping.shot, mapping.inputs()
     rows = []
     for record in design.to_dict("records"):
-        params = shot_parameters(record, config, shot)
+        params = mapping.parameters(record)
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
                "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
                "shear_modulus_GPa": params.shear_modulus_Mbar * MBAR_TO_GPA}

@@ -10,14 +10,15 @@ serves both channels a stage gets its settings through:
   the tests) instead of silently missing from the rerun triggers.
 
 Path segments: a key; `*` every key at that level (e.g. every shot); `{shot}` the shot the job
-works on; `{shot_inputs}` the design columns that shot reads (`config.shot_inputs`).
+works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`).
 """
 from __future__ import annotations
 
 import copy
 from collections.abc import Iterable, Iterator
 
-from shockcal.config import load_config, shot_config, shot_inputs
+from shockcal.config import load_config, shot_config
+from shockcal.design import ShotMapping
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
@@ -101,7 +102,7 @@ def _expand(config: dict, parts: list[str], shot: str | None, stage: str) -> Ite
             parts = [*parts[:i], shot, *parts[i + 1:]]
         elif part in ("*", "{shot_inputs}"):
             node = _node(config, parts[:i], f"{stage}: {'.'.join(parts)}")
-            keys = node if part == "*" else shot_inputs(config, shot)
+            keys = node if part == "*" else ShotMapping.from_config(config, shot).inputs()
             for key in keys:
                 yield from _expand(config, [*parts[:i], key, *parts[i + 1:]], shot, stage)
             return

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from shockcal.config import load_config
-from shockcal.design import latin_hypercube
-from shockcal.features import features_table
-from shockcal.simulate import simulate_design
+from shockcal.config import load_config, prior_bounds
+from shockcal.design import ShotMapping, latin_hypercube
+from shockcal.features import ExtractorSettings, features_table
+from shockcal.simulate import hydro_inputs, simulate_design
 
 REPO = Path(__file__).resolve().parents[2]
 OUT = Path(__file__).with_name("end_time_reference.csv")
@@ -23,7 +23,7 @@ OUT = Path(__file__).with_name("end_time_reference.csv")
 
 def reference_design(config: dict) -> pd.DataFrame:
     """The fixed runs: 3 hypercube points (seed 12) and the two late-arrival corners."""
-    design = latin_hypercube(config, 3, seed=12)
+    design = latin_hypercube(prior_bounds(config), 3, seed=12)
     low = {k: v["min"] for k, v in config["inputs"].items()}
     softening = {**low, "m": config["inputs"]["m"]["min"], "C": config["inputs"]["C"]["max"],
                  "n": config["inputs"]["n"]["max"]}
@@ -37,8 +37,10 @@ def features_at(config: dict, end_time_us, runs=None) -> pd.DataFrame:
     design = reference_design(config)
     if runs is not None:
         design = design[design["run"].isin(runs)]
-    tables = [features_table(simulate_design(design, config, shot), config, shot).assign(shot=shot)
-              for shot in config["shots"]]
+    tables = []
+    for shot, spec in config["shots"].items():
+        traces = simulate_design(design, ShotMapping.from_config(config, shot), *hydro_inputs(config, spec))
+        tables.append(features_table(traces, ExtractorSettings.from_config(config, shot)).assign(shot=shot))
     return pd.concat(tables, ignore_index=True)
 
 

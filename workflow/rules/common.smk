@@ -4,8 +4,7 @@ import os
 
 import yaml
 
-from shockcal.config import shot_inputs
-from shockcal.design import chunk_fingerprints, study_design, write_design
+from shockcal.design import ShotMapping, chunk_fingerprints, study_design, write_design
 from shockcal.stages import figure_config, stage_config
 from shockcal.workflow import (
     chunk_count,

@@ -20,7 +20,8 @@ write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, config, DESIGN)
 # a digest per shot and chunk, over the run ids and the columns that shot reads: a column added for
 # a new shot (its impact velocity) leaves every other shot's chunks alone
 CHUNK_DIGESTS = {
-    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_inputs(config, shot)]], CHUNK_SIZE) for shot in SHOTS
+    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *ShotMapping.from_config(config, shot).inputs()]], CHUNK_SIZE)
+    for shot in SHOTS
 }
 RUN_SET_SIZES = {
     "training": len(_PLANNED_DESIGN),

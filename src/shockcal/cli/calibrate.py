@@ -71,18 +71,22 @@ def run(args) -> int:
 
 
 def run_check(args) -> int:
-    from shockcal.calibration import coverage_check
+    from shockcal.calibration import CalibrationSettings, coverage_table, synthetic_truth
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
+    from shockcal.seeds import stream_seed
     from shockcal.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate_check")
     truths = hydro_truths(args)
-    table, coverage = coverage_check(Emulator.load(args.emulator), args.shots, config,
-                                     trials=trial_range(args.trial_range) or args.trials, truths=truths)
+    truth = "emulator" if truths is None else "hydrocode"
+    trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
+    table = synthetic_truth(Emulator.load(args.emulator), args.shots,
+                            CalibrationSettings.from_config(config, args.shots, check=True), trials,
+                            seed=stream_seed(config["study"]["seed"], "check", truth, *args.shots), truths=truths)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
-    log_coverage(coverage, table)
+    log_coverage(coverage_table(table), table)
     return 0
 
 

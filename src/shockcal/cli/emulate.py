@@ -37,23 +37,22 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     import logging
+    from dataclasses import replace
     from pathlib import Path
 
-    from shockcal.config import shot_config
     from shockcal.design import load_design
-    from shockcal.emulator import fit_emulator
+    from shockcal.emulator import EmulatorSpec, fit_emulator
     from shockcal.io import read_table
     from shockcal.stages import load_stage_config
 
     config = load_stage_config(args.config, "emulate")
-    if args.structure:
-        config["emulator"]["structure"] = args.structure
     paths = parse_pairs(args.features, "--features")
-    for shot in paths:
-        shot_config(config, shot)
+    spec = EmulatorSpec.from_config(config, list(paths))
+    if args.structure:
+        spec = replace(spec, structure=args.structure)
     design = load_design(args.design, config)
     features = {shot: read_table(path) for shot, path in paths.items()}
-    emulator = fit_emulator(config, design, features, sources=paths)
+    emulator = fit_emulator(design, features, spec, sources=paths)
     out = Path(args.out)
     emulator.save(out)
     settings = config["emulator"]

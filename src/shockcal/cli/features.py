@@ -35,15 +35,15 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import pandas as pd
 
-    from shockcal.features import check_failures, record_features
+    from shockcal.features import ExtractorSettings, check_failures, record_features
     from shockcal.io import read_table, write_table
     from shockcal.stages import load_stage_config
 
     config = load_stage_config(args.config, feature_stages(args), args.shot)
     if args.record:
         table = pd.DataFrame([{"run": 0, "status": "ok", "reason": "",
-                               **record_features(config, args.shot, args.record, args.time_column,
-                                                 args.velocity_column)}])
+                               **record_features(args.record, ExtractorSettings.from_config(config, args.shot),
+                                                 args.shot, args.time_column, args.velocity_column)}])
     else:
         from shockcal.features import features_table
         from shockcal.io import read_tables
@@ -52,7 +52,7 @@ def run(args) -> int:
             table = read_tables(args.tables, ["run"], "features")
         else:
             traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
-            table = features_table(traces, config, args.shot)
+            table = features_table(traces, ExtractorSettings.from_config(config, args.shot))
         if not args.no_failure_budget:
             check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
     write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,

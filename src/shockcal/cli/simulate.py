@@ -20,21 +20,23 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import shot_inputs
-    from shockcal.design import load_design, validate_shot_parameters
+    from shockcal.config import shot_config
+    from shockcal.design import ShotMapping, load_design
     from shockcal.errors import InputError
     from shockcal.io import write_table
-    from shockcal.simulate import UNITS, simulate_design
+    from shockcal.simulate import UNITS, hydro_inputs, simulate_design
     from shockcal.stages import load_stage_config
 
     config = load_stage_config(args.config, "simulate", args.shot)
     rows = slice(*parse_span(args.rows, "--rows"))
-    design = load_design(args.design, config, columns=shot_inputs(config, args.shot)).iloc[rows]
-    validate_shot_parameters(design, config, args.shot, args.design)
     if args.end_time_us is not None and args.end_time_us <= 0:
         raise InputError(f"--end-time-us: {args.end_time_us} is not a positive time")
-    table = simulate_design(design, config, args.shot, args.end_time_us)
-    units = {**UNITS, **{k: config["inputs"][k]["unit"] for k in shot_inputs(config, args.shot)}}
+    mapping = ShotMapping.from_config(config, args.shot)
+    geometry, material, settings = hydro_inputs(config, shot_config(config, args.shot), args.end_time_us)
+    design = load_design(args.design, config, columns=mapping.inputs()).iloc[rows]
+    mapping.check_positive(design, args.design)
+    table = simulate_design(design, mapping, geometry, material, settings)
+    units = {**UNITS, **{k: config["inputs"][k]["unit"] for k in mapping.inputs()}}
     write_table(table, args.out, {"table": "simulations", "shot": args.shot, "units": units,
                                   "hydro": config["hydro"], "material": config["material"]})
     failed = int((table["status"] != "ok").sum()) if len(table) else 0

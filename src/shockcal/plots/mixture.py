@@ -46,12 +46,10 @@ class TraceExtraction:
 
 def extract_view(trace: pd.DataFrame, config: dict, shot: str) -> TraceExtraction:
     """Run the project's extractor on `trace` with the shot's analysis settings."""
-    from shockcal.features import extract
+    from shockcal.features import ExtractorSettings, extract
 
     t, v = trace["t_us"].to_numpy(float), trace["v_m_s"].to_numpy(float)
-    analysis, settings = config["shots"][shot]["analysis"], config["features"]
-    ex = extract(t, v, analysis["window_after_arrival_us"], analysis["cutoff_after_arrival_us"],
-                 settings["n_components"], settings["n_samples"])
+    ex = extract(t, v, ExtractorSettings.from_config(config, shot))
     return TraceExtraction(t, v, ex)
 
 
