@@ -25,7 +25,7 @@ study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and
 	@echo "report: $(CURDIR)/results/report.html"
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
-	snakemake --cores $(CORES) --configfile config/quick.yaml all
+	snakemake --cores $(CORES) all --configfile config/quick.yaml
 
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
 	snakemake --cores $(CORES) check

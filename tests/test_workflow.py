@@ -324,3 +324,11 @@ def test_interrupted_fan_out_finishes_with_identical_results(study, tmp_path, si
         pd.testing.assert_frame_equal(ours, reference, check_exact=True)
     pd.testing.assert_frame_equal(pd.read_parquet(target), pd.read_parquet(results / "training" / "features" / "104S.parquet"),
                                   check_exact=True)
+
+
+def test_make_quick_names_its_target_before_the_configfile():
+    """`make quick`'s snakemake line parses: a target after --configfile would be read as a config file."""
+    lines = subprocess.run(["make", "-n", "quick"], cwd=REPO, capture_output=True, text=True, check=True).stdout
+    command = next(line.split() for line in lines.splitlines() if line.startswith("snakemake "))
+    done = subprocess.run([SNAKEMAKE, "--dry-run", *command[1:]], cwd=REPO, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
