@@ -139,3 +139,9 @@ def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
     assert main(["emulate-cv", "--emulator", str(tmp_path / "emu")]) == 0
     assert main(["emulate", "--config", str(quick), "--design", str(tmp_path / "design.csv"),
                  "--features", "104S", "--out", str(tmp_path / "x")]) == 2
+
+
+def test_features_of_a_shot_the_spec_does_not_map_are_rejected(paper_config):
+    design, features, _ = _synthetic_study(paper_config, n=30)
+    with pytest.raises(InputError, match=r"features of shots \['106S'\]: the emulator spec maps only \['104S'\]"):
+        fit_emulator(design, {"104S": features, "106S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))

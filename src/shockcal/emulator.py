@@ -7,8 +7,8 @@ and covariance of the outputs, adding the covariance of what the truncated basis
 output's sd scaled by a factor calibrated by K-fold. Cross-validation: closed-form LOO (diagnostic),
 K-fold and the outer check (everything refitted).
 
-The study's `Emulator` (from `fit_emulator`, on an `EmulatorSpec`) maps design columns to emulator inputs, in one of two
-structures (config `emulator.structure`):
+The study's `Emulator` (`fit_emulator` on an `EmulatorSpec`) maps design columns to emulator
+inputs, in one of two structures (config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
@@ -659,6 +659,9 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
     """Fit the study's emulator to a design (Table IV units) and per-shot feature tables (m/s, us),
     joined on `run`; block i fits with stream ("emulator", i) of `spec.settings.seed`."""
     shots = list(features)
+    unmapped = [shot for shot in shots if shot not in spec.shots]
+    if unmapped:
+        raise InputError(f"features of shots {unmapped}: the emulator spec maps only {list(spec.shots)}")
     mappings = [spec.shots[shot] for shot in shots]
     sources = sources or {shot: f"features of {shot}" for shot in shots}
     tables = {shot: training_data(design, features[shot], shot, sources[shot]) for shot in shots}
