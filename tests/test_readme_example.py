@@ -31,16 +31,20 @@ def test_readme_notebook_example_recovers_the_inputs_that_made_the_measurement()
 def test_readme_hydrocode_shot_is_the_study_configs_run(paper_config):
     """The two-line shot runs, its plateau is near the impact velocity (symmetric impact), and its defaults
     (Al-5083, the numerics) are the study config's: the same run through the config adapter is
-    bit-identical."""
+    bit-identical, and so are its features read with the config's 104S settings."""
+    from shockcal.features import ExtractorSettings, extract_features
     from shockcal.hydro import run_shot
     from shockcal.simulate import hydro_inputs
 
-    result = _run_block(1)["result"]
+    scope = _run_block(1)
+    result = scope["result"]
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s
     plateau = np.median(v[(t > 1.6) & (t < 2.0)])          # m/s; strength holds it a few % below 204
     assert 0.95 * 204.0 < plateau < 204.0
     spec = {"flyer_mm": 3.95, "target_mm": 5.965}
-    params = _run_block(1)["ShotParameters"](0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.269)
-    from_config = run_shot(params, *hydro_inputs(paper_config, spec, end_us=2.0))
+    params = scope["ShotParameters"](0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.269)
+    from_config = run_shot(params, *hydro_inputs(paper_config, spec, end_us=2.2))
     assert np.array_equal(from_config.v_m_s, v)
+    assert scope["features"] == extract_features(t, v, ExtractorSettings.from_config(paper_config, "104S"))
+    assert scope["features"]["v_elastic"] < scope["features"]["v_plastic"] <= v.max()
