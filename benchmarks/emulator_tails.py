@@ -7,9 +7,11 @@ under the covariance, against the Gaussian (chi-square) and against the block's 
 Student t: d^2 / (F scale) ~ F(F, dof)): the share beyond each one's 90% and 99% points (0.10 and 0.01
 when the model is right) and the KS p-value; with the calibration's observation noise added, the share
 of real residuals beyond the 90% point of residuals the model draws itself; and the runs with the
-largest distances. The shots and the noise's sd fraction come from the study's config; the noise is drawn as
-the check draws it. Needs `make check`'s check runs and the emulator under the results directory;
-prints, never asserts.
+largest distances. Last, where in the box the errors outgrow the emulator's sd: per fifth of each input's
+box, the mean d^2 / F of the check runs and the mean z^2 of the K-fold errors of the training runs
+(results/emulator/cv_heldout.parquet), both 1 when the sds are right. The shots and the noise's sd
+fraction come from the study's config; the noise is drawn as the check draws it. Needs `make check`'s
+check runs and the emulator under the results directory; prints, never asserts.
 Usage: python benchmarks/emulator_tails.py [RESULTS_DIR [CONFIG]]
 """
 
@@ -93,7 +95,24 @@ def main(results: Path, config_path: Path) -> int:
         for i in top:
             j = cols[np.abs(z[i, cols]).argmax()]
             print(f"    {i}: {d2[i]:.1f}, {columns[j]}, {abs(z[i, j]):.1f}")
+    print_by_input_fifth(results, emulator, names, theta, mahalanobis(err, cov) / err.shape[1])
     return 0
+
+
+def print_by_input_fifth(results: Path, emulator: Emulator, names, theta, d2_per_feature) -> None:
+    """Mean d^2 / F of the check runs and mean K-fold z^2 of the training runs, per fifth of each input's box."""
+    lower, upper = emulator.input_bounds(names)
+    fifths = lambda x: np.clip(((x - lower) / (upper - lower) * 5).astype(int), 0, 4)  # noqa: E731
+    cv = pd.read_parquet(results / "emulator" / "cv_heldout.parquet").query("scheme == 'kfold'")
+    z2 = ((cv["predicted"] - cv["simulated"]) / cv["predicted_sd"]) ** 2
+    kfold = cv.assign(z2=z2).groupby("run")["z2"].mean()
+    design = pd.read_parquet(results / "training" / "design.parquet").set_index("run").loc[kfold.index, names]
+    check_bin, kfold_bin = fifths(theta), fifths(design.to_numpy())
+    print("\nmean d^2 / F of the check runs | mean K-fold z^2 of the training runs, per fifth of each input's box "
+          "(1 when the sds are right):")
+    rows = {name: [f"{d2_per_feature[check_bin[:, j] == k].mean():.2f} | {kfold.to_numpy()[kfold_bin[:, j] == k].mean():.2f}"
+                   for k in range(5)] for j, name in enumerate(names)}
+    print(pd.DataFrame(rows, index=[f"fifth {k + 1}" for k in range(5)]).T.to_string())
 
 
 if __name__ == "__main__":
