@@ -41,7 +41,7 @@ def load() -> str:
     return f"load {os.getloadavg()[0]:.1f}"
 
 
-def reference(problem, name: str, directory: Path, n_live: int, n_eff: int) -> pd.DataFrame:
+def reference(problem, name: str, directory: Path, n_live: int, n_eff: int, seed: int = 1) -> pd.DataFrame:
     """nautilus's weighted draws of this posterior (columns: parameters, weight), run once and kept."""
     path = directory / f"reference_{name}.parquet"
     if path.is_file():
@@ -50,14 +50,14 @@ def reference(problem, name: str, directory: Path, n_live: int, n_eff: int) -> p
 
     start = time.perf_counter()
     sampler = Sampler(problem.prior_transform, problem.log_likelihood, n_dim=problem.ndim, n_live=n_live,
-                      vectorized=True, seed=1, n_networks=1)
+                      vectorized=True, seed=seed, n_networks=1)
     sampler.run(n_eff=n_eff, discard_exploration=True)
     points, log_w, _ = sampler.posterior()
     w = np.exp(log_w - log_w.max())
     frame = pd.DataFrame(points, columns=[*problem.names, "lambda_y"]).assign(weight=w / w.sum())
     directory.mkdir(parents=True, exist_ok=True)
     frame.to_parquet(path)
-    print(f"  reference (nautilus, n_live {n_live}, n_eff {n_eff}): {time.perf_counter() - start:.0f} s wall, "
+    print(f"  reference (nautilus, n_live {n_live}, n_eff {n_eff}, seed {seed}): {time.perf_counter() - start:.0f} s wall, "
           f"{sampler.n_like} evaluations, Kish ESS {1 / np.sum(frame['weight'] ** 2):.0f}, "
           f"log evidence {sampler.log_z:.3f} ({load()})")
     return frame
@@ -217,6 +217,8 @@ def main(argv=None) -> int:
                         help="where reference posteriors are kept (one per emulator: use one directory each)")
     parser.add_argument("--reference-live", type=int, default=2000)
     parser.add_argument("--reference-eff", type=int, default=20000)
+    parser.add_argument("--reference-seed", type=int, default=1,
+                        help="seed of a new reference run (a second seed checks the reference itself)")
     parser.add_argument("--smc", action="store_true", help="also run smcpy's adaptive SMC")
     parser.add_argument("--smc-particles", type=int, default=4000)
     parser.add_argument("--smc-moves", type=int, default=5)
@@ -237,7 +239,8 @@ def main(argv=None) -> int:
         shots = SHOTS if name == "joint" else [name]
         problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"])
         names = [*problem.names, "lambda_y"]
-        ref = reference(problem, name, Path(args.reference_dir), args.reference_live, args.reference_eff)
+        ref = reference(problem, name, Path(args.reference_dir), args.reference_live, args.reference_eff,
+                        args.reference_seed)
         width = np.append(problem.upper - problem.lower, LAMBDA_Y_SPAN)
         print(f"== {name}: {len(names)} parameters")
         if args.replicates:
