@@ -65,8 +65,9 @@ def main() -> None:
              (lambda: features_table(traces, settings), N_TRACES)}
     for shot, spec in config["observed"]["records"].items():
         t, v = read_record(REPO / spec["path"])
+        shot_settings = ExtractorSettings.from_config(config, shot)
         cases[f"measured record {shot} ({len(t)} points)"] = (
-            lambda t=t, v=v, shot=shot: extract_features(t, v, ExtractorSettings.from_config(config, shot)), 1)
+            lambda t=t, v=v, s=shot_settings: extract_features(t, v, s), 1)
     features_table(traces.head(1), settings)  # warm-up: imports, first fit
     print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (timings inflated when high)")
     print(f"{'':45}{'ms/trace':>10}{'1 thread':>10}   goal {GOAL_MS:.0f}")

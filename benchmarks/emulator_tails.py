@@ -102,7 +102,10 @@ def main(results: Path, config_path: Path) -> int:
 def print_by_input_fifth(results: Path, emulator: Emulator, names, theta, d2_per_feature) -> None:
     """Mean d^2 / F of the check runs and mean K-fold z^2 of the training runs, per fifth of each input's box."""
     lower, upper = emulator.input_bounds(names)
-    fifths = lambda x: np.clip(((x - lower) / (upper - lower) * 5).astype(int), 0, 4)  # noqa: E731
+
+    def fifths(x):
+        return np.clip(((x - lower) / (upper - lower) * 5).astype(int), 0, 4)
+
     cv = pd.read_parquet(results / "emulator" / "cv_heldout.parquet").query("scheme == 'kfold'")
     z2 = ((cv["predicted"] - cv["simulated"]) / cv["predicted_sd"]) ** 2
     kfold = cv.assign(z2=z2).groupby("run")["z2"].mean()
