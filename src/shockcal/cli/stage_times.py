@@ -13,9 +13,13 @@ def run(args) -> int:
     from pathlib import Path
 
     from shockcal.errors import InputError
-    from shockcal.stage_times import stage_table
+    from shockcal.stage_times import simulate_overhead, stage_table
 
     if not Path(args.benchmarks).is_dir():
         raise InputError(f"{args.benchmarks}: no such folder (run the study first)")
     print(stage_table(Path(args.benchmarks)).to_string(index=False))
+    overhead = simulate_overhead(Path(args.benchmarks))
+    if len(overhead):
+        print("\nsimulate jobs: start-up and write-out (job wall s minus its runs' hydrocode s), median and range:")
+        print(overhead.to_string(index=False))
     return 0
