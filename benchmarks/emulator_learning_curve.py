@@ -33,6 +33,7 @@ def load() -> str:
 
 
 def ok_features(path: Path) -> pd.DataFrame:
+    """The check runs' features, failed runs dropped (the training runs' are dropped by `fit_emulator`)."""
     table = pd.read_parquet(path)
     return table[table["status"] == "ok"]
 
@@ -67,7 +68,7 @@ def main() -> None:
     if missing:
         raise SystemExit(f"missing {', '.join(missing)}: run `make study` and `make check` first")
     design = pd.read_parquet(args.results / "training" / "design.parquet")
-    training = {s: ok_features(args.results / "training" / "features" / f"{s}.parquet") for s in shots}
+    training = {s: pd.read_parquet(args.results / "training" / "features" / f"{s}.parquet") for s in shots}
     check_design = pd.read_parquet(args.results / "check" / "design.parquet")
     check = {s: ok_features(args.results / "check" / "features" / f"{s}.parquet") for s in shots}
     spec = EmulatorSpec.from_config(config, shots)

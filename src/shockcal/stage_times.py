@@ -22,10 +22,10 @@ def stage_table(benchmarks: Path) -> pd.DataFrame:
     """One row per stage: jobs, summed wall and CPU seconds, the longest job's wall seconds; then a total."""
     rows = []
     for tsv in sorted(Path(benchmarks).rglob("*.tsv")):
-        bench = pd.read_csv(tsv, sep="\t")
+        bench = job_benchmark(tsv)
         parts = tsv.relative_to(benchmarks).parts
         stage = "/".join(parts[:2]) if len(parts) > 2 else Path(parts[0]).stem
-        rows.append({"stage": stage, "wall_s": float(bench["s"].iloc[-1]), "cpu_s": float(bench["cpu_time"].iloc[-1])})
+        rows.append({"stage": stage, "wall_s": float(bench["s"]), "cpu_s": float(bench["cpu_time"])})
     if not rows:
         return pd.DataFrame(columns=["stage", "jobs", "wall_s", "cpu_s", "longest_job_s"])
     jobs = pd.DataFrame(rows)
@@ -46,7 +46,7 @@ def simulate_overhead(benchmarks: Path) -> pd.DataFrame:
         chunk = benchmarks.parent / run_set / "simulations" / shot / f"{Path(name).stem}.parquet"
         if not chunk.is_file():
             continue
-        job_s = float(pd.read_csv(tsv, sep="\t")["s"].iloc[-1])
+        job_s = float(job_benchmark(tsv)["s"])
         hydro_s = float(pd.read_parquet(chunk, columns=["wall_time_s"])["wall_time_s"].sum())
         rows.append({"run_set": run_set, "overhead_s": job_s - hydro_s, "share": (job_s - hydro_s) / job_s})
     if not rows:
@@ -57,3 +57,8 @@ def simulate_overhead(benchmarks: Path) -> pd.DataFrame:
                                                     max_pct=("share", "max"))
     table[["share_pct", "min_pct", "max_pct"]] *= 100
     return table.reset_index().round(2)
+
+
+def job_benchmark(tsv: Path) -> pd.Series:
+    """A job's benchmark: the last row of its file (columns `s` = wall seconds, `cpu_time` = CPU seconds)."""
+    return pd.read_csv(tsv, sep="\t").iloc[-1]
