@@ -1,7 +1,7 @@
 # shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
-from shockcal.config import validate_or_exit
+from shockcal.study.validate import validate_or_exit
 
 
 configfile: "config/config.yaml"

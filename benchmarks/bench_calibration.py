@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.calibration import quantile_mcse, weighted_quantiles
+from shockcal.summaries import quantile_mcse, weighted_quantiles
 
 REPO = Path(__file__).resolve().parents[1]
 QUANTILES = [0.05, 0.25, 0.5, 0.75, 0.95]
@@ -201,10 +201,10 @@ def run_emcee(problem, evaluations: int, seed: int):
 
 
 def main(argv=None) -> int:
-    from shockcal.calibration import Problem
-    from shockcal.config import load_config
     from shockcal.emulator import Emulator
     from shockcal.io import read_table
+    from shockcal.problem import Problem
+    from shockcal.study.validate import load_config
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--emulator", default=str(REPO / "results" / "emulator"), help="emulator directory")
@@ -237,7 +237,7 @@ def main(argv=None) -> int:
           f"ESS {settings['n_eff']}, cube powers {settings['cube_power']}")
     for name in args.only:
         shots = SHOTS if name == "joint" else [name]
-        problem = Problem.build(emulator, shots, observed, config["observed"]["sd_fraction"])
+        problem = Problem.for_shots(emulator, shots, observed, config["observed"]["sd_fraction"])
         names = [*problem.names, "lambda_y"]
         ref = reference(problem, name, Path(args.reference_dir), args.reference_live, args.reference_eff,
                         args.reference_seed)

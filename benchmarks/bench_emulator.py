@@ -16,9 +16,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.config import load_config
-from shockcal.emulator import CALIBRATION_FEATURES, EmulatorSpec, fit_emulator, rmse_table
+from shockcal.emulator import fit_emulator, rmse_table
+from shockcal.features import CALIBRATION_FEATURES
 from shockcal.reference import reference_dir
+from shockcal.study.adapters import emulator_spec
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 SHOTS = ["104S", "105S", "106S"]
@@ -59,7 +61,7 @@ def main() -> None:
     inputs = {k: design[k].to_numpy() for k in design.columns if k != "run"}
     flag = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
     print("FLAG features, runs 0-499 (joint):")
-    emulator = timed("fit", lambda: fit_emulator(design, flag, EmulatorSpec.from_config(config, SHOTS)))
+    emulator = timed("fit", lambda: fit_emulator(design, flag, emulator_spec(config, SHOTS)))
     print(f"  ({len(emulator.blocks[0].model.gps)} components)")
     cv = [timed("closed-form LOO", lambda: emulator.cv_table("loo_closed_form"))]
     cv.append(timed(f"{settings['cv_folds']}-fold", lambda: emulator.cv_table("kfold", folds=settings["cv_folds"])))
@@ -79,7 +81,7 @@ def main() -> None:
 def fit_and_kfold(config, design, features, inputs) -> None:
     """Fit (with its K-fold sd calibration) and the K-fold table, timed; then prediction."""
     start = time.perf_counter()
-    emulator = timed("fit", lambda: fit_emulator(design, features, EmulatorSpec.from_config(config, SHOTS)))
+    emulator = timed("fit", lambda: fit_emulator(design, features, emulator_spec(config, SHOTS)))
     print(f"  ({len(emulator.blocks[0].model.gps)} components, {len(emulator.blocks[0].runs)} runs)")
     folds = config["emulator"]["cv_folds"]
     table = rmse_table(timed(f"{folds}-fold", lambda: emulator.cv_table("kfold", folds=folds)))

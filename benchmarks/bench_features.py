@@ -19,9 +19,10 @@ import pandas as pd
 from scipy.stats import norm
 from threadpoolctl import threadpool_limits
 
-from shockcal.config import load_config
-from shockcal.features import ExtractorSettings, extract_features, features_table
+from shockcal.features import extract_features, features_table
 from shockcal.records import read_record
+from shockcal.study.adapters import extractor_settings
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIG = REPO / "config" / "config.yaml"
@@ -60,12 +61,12 @@ def _seconds(function) -> float:
 def main() -> None:
     config = load_config(CONFIG)
     traces = simulated_like(N_TRACES)
-    settings = ExtractorSettings.from_config(config, SHOT)
+    settings = extractor_settings(config, SHOT)
     cases = {f"{N_TRACES} simulated-like traces ({SHOT} window)":
              (lambda: features_table(traces, settings), N_TRACES)}
     for shot, spec in config["observed"]["records"].items():
         t, v = read_record(REPO / spec["path"])
-        shot_settings = ExtractorSettings.from_config(config, shot)
+        shot_settings = extractor_settings(config, shot)
         cases[f"measured record {shot} ({len(t)} points)"] = (
             lambda t=t, v=v, s=shot_settings: extract_features(t, v, s), 1)
     features_table(traces.head(1), settings)  # warm-up: imports, first fit

@@ -22,10 +22,13 @@ import numpy as np  # noqa: E402
 
 os.environ.setdefault("NUMBA_CACHE_DIR", tempfile.mkdtemp(prefix="shockcal-bench-numba-"))
 
-from shockcal.config import end_time_us, load_config, shot_config  # noqa: E402
-from shockcal.design import ShotParameters  # noqa: E402
-from shockcal.hydro import run_shot  # noqa: E402
-from shockcal.simulate import hydro_inputs  # noqa: E402
+from shockcal.hydro import (
+    ShotParameters,  # noqa: E402
+    run_shot,  # noqa: E402
+)
+from shockcal.study.adapters import hydro_inputs  # noqa: E402
+from shockcal.study.config import end_time_us, shot_config
+from shockcal.study.validate import load_config  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 GRAY = dict(A=0.0017, B=0.00425, C=0.0335, n=0.42, m=1.225)
@@ -70,7 +73,7 @@ def main() -> None:
     print(f"load average at start: {os.getloadavg()[0]:.2f} (timings inflated when > 0)")
     start = time.perf_counter()
     tiny = dict(shot_config(config, "104S"), flyer_mm=0.05, target_mm=0.05)
-    run_shot(ShotParameters(**GRAY, velocity_cm_us=0.0204, shear_modulus_Mbar=0.27),
+    run_shot(ShotParameters.from_table_iv(**GRAY, velocity_cm_us=0.0204, shear_modulus_Mbar=0.27),
              *hydro_inputs(config, tiny, end_us=0.01))
     print(f"JIT compile (cold cache): {time.perf_counter() - start:.1f} s")
     dx_um = config["hydro"]["cell_size_um"]
@@ -78,7 +81,7 @@ def main() -> None:
     results = {}
     for shot, velocity in NOMINAL_V.items():
         spec = shot_config(config, shot)
-        params = ShotParameters(**GRAY, velocity_cm_us=velocity, shear_modulus_Mbar=0.27)
+        params = ShotParameters.from_table_iv(**GRAY, velocity_cm_us=velocity, shear_modulus_Mbar=0.27)
         cells = round(spec["flyer_mm"] * 1e3 / dx_um) + round(spec["target_mm"] * 1e3 / dx_um)
         for end_us in (4.0, end_time_us(config, spec)):                     # the paper's end time, then ours
             inputs = hydro_inputs(config, spec, end_us)

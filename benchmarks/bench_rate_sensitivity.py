@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from shockcal.config import load_config, shot_config
-from shockcal.design import ShotParameters
-from shockcal.hydro import run_shot
-from shockcal.simulate import hydro_inputs
+from shockcal.hydro import ShotParameters, run_shot
+from shockcal.study.adapters import hydro_inputs
+from shockcal.study.config import shot_config
+from shockcal.study.validate import load_config
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 SHOT = "106S"
@@ -33,7 +33,7 @@ WINDOW_US = (1.0, 2.1)     # the 106S analysis window of these runs (arrival abo
 
 def run(C: float, cfl: float, velocity: float, inputs):
     geometry, material, settings = inputs
-    params = ShotParameters(0.008397, 0.008210, C, 0.458981, 2.26, velocity, 0.30)
+    params = ShotParameters.from_table_iv(0.008397, 0.008210, C, 0.458981, 2.26, velocity, 0.30)
     return run_shot(params, geometry, material, dataclasses.replace(settings, cfl=cfl))
 
 

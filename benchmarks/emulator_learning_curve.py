@@ -22,8 +22,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.config import load_config
-from shockcal.emulator import CALIBRATION_FEATURES, EmulatorSpec, fit_emulator
+from shockcal.emulator import fit_emulator
+from shockcal.features import CALIBRATION_FEATURES
+from shockcal.study.adapters import emulator_spec
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -71,7 +73,7 @@ def main() -> None:
     training = {s: pd.read_parquet(args.results / "training" / "features" / f"{s}.parquet") for s in shots}
     check_design = pd.read_parquet(args.results / "check" / "design.parquet")
     check = {s: ok_features(args.results / "check" / "features" / f"{s}.parquet") for s in shots}
-    spec = EmulatorSpec.from_config(config, shots)
+    spec = emulator_spec(config, shots)
     print(f"unseen: {len(check_design)} check runs per shot; error model {config['emulator']['error_tails']}")
     print(f"{'runs':>6}{'RMSE m/s':>10}{'mean z^2':>10}{'in 90%':>8}{'fit s':>8}")
     for n in args.runs:

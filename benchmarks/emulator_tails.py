@@ -22,10 +22,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.calibration import HydroTruths, _noisy_features
-from shockcal.config import load_config
+from shockcal.coverage import HydroTruths, _noisy_features
 from shockcal.emulator import Emulator
 from shockcal.error_model import ErrorModel
+from shockcal.study.validate import load_config
 
 NOISE_DRAWS = 50
 

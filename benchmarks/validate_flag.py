@@ -24,12 +24,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.config import load_config
-from shockcal.design import ShotMapping
 from shockcal.errors import InputError
-from shockcal.features import COLUMNS, ExtractorSettings, features_table, record_features
+from shockcal.features import COLUMNS, features_table, record_features
 from shockcal.reference import require_reference_dir
-from shockcal.simulate import hydro_inputs, simulate_design
+from shockcal.simulate import simulate_design
+from shockcal.study.adapters import emulator_spec, extractor_settings, hydro_inputs, shot_mapping
+from shockcal.study.validate import load_config
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 SHOTS = ["104S", "105S", "106S"]
@@ -60,8 +60,8 @@ def simulate_chunk(task) -> pd.DataFrame:
 
     shot, rows, config = task
     with threadpool_limits(1):
-        traces = simulate_design(rows, ShotMapping.from_config(config, shot), *hydro_inputs(config, config["shots"][shot]))
-        return features_table(traces, ExtractorSettings.from_config(config, shot)).assign(shot=shot)
+        traces = simulate_design(rows, shot_mapping(config, shot), *hydro_inputs(config, config["shots"][shot]))
+        return features_table(traces, extractor_settings(config, shot)).assign(shot=shot)
 
 
 def compare(ours: pd.DataFrame, flag: pd.DataFrame) -> pd.DataFrame:
@@ -93,10 +93,12 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
                           config: dict) -> pd.DataFrame:
     """Per calibration feature: R^2 of a 10-fold GP prediction of ours - FLAG from the shot's inputs
     (with the emulator's input powers), and the scatter sd (m/s) it leaves."""
-    from shockcal.emulator import CALIBRATION_FEATURES, EmulatorSpec, PCGPEmulator, Settings, shot_input_map
+    from shockcal.emulator import shot_input_map
+    from shockcal.features import CALIBRATION_FEATURES
+    from shockcal.pcgp import PCGPEmulator, Settings
 
     ok = ours[ours["status"] == "ok"].set_index("run")
-    spec = EmulatorSpec.from_config(config, [shot])
+    spec = emulator_spec(config, [shot])
     input_map = shot_input_map(spec.shots[shot], spec.bounds, spec.powers)
     x = input_map.raw(design.set_index("run").loc[ok.index])
     rows = {}
@@ -138,7 +140,7 @@ def print_records(config: dict, ref: Path, shots) -> None:
     print("\nmeasured records vs published features (ours - published; m/s, ns)")
     print("  shot " + "".join(f"{c:>11}" for c in COLUMNS))
     for shot in shots:
-        ours = record_features(ref / "visar" / f"Data_S{shot}.txt", ExtractorSettings.from_config(config, shot), shot)
+        ours = record_features(ref / "visar" / f"Data_S{shot}.txt", extractor_settings(config, shot), shot)
         print(f"  {shot} " + "".join(f"{(ours[c] - published.loc[shot, c]) * (1e3 if c.startswith('t_') else 1):+11.2f}"
                                      for c in COLUMNS))
 

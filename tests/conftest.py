@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from shockcal.config import load_config
 from shockcal.reference import reference_dir
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 

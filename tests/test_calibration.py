@@ -5,20 +5,13 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from shockcal.calibration import (
-    LAMBDA_Y_PRIOR,
-    SUMMARY_QUANTILES,
-    CalibrationSettings,
-    Problem,
-    SamplerSettings,
-    calibrate,
-    observed_vector,
-    quantile_mcse,
-    sample,
-    weighted_quantiles,
-)
+from shockcal.calibration import calibrate
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
+from shockcal.problem import LAMBDA_Y_PRIOR, Problem, observed_vector
+from shockcal.sampler import SamplerSettings, sample
+from shockcal.study.adapters import calibration_settings
+from shockcal.summaries import SUMMARY_QUANTILES, quantile_mcse, weighted_quantiles
 
 
 class StandInEmulator:
@@ -55,8 +48,8 @@ def _posterior_on_grid(problem, grids):
 
 
 def _sample(problem, n_eff, seed, n_live=300):
-    samples, summary, _ = sample(problem, SamplerSettings(n_live, n_eff, 20000, seed))
-    return samples, summary
+    posterior = sample(problem, SamplerSettings(n_live=n_live, n_eff=n_eff, draws=20000, seed=seed))
+    return posterior.draws, posterior.summary()
 
 
 def _observed(y):
@@ -66,7 +59,7 @@ def _observed(y):
 def test_linear_gaussian_posterior_mean_and_variance_match_the_exact_answer():
     H = np.array([[30.0, 5.0], [-4.0, 40.0]])
     emulator = StandInEmulator(lambda t: 100.0 + t @ H.T, ["a", "b"], [-1, -1], [1, 1], 0.25 * np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([106.0, 108.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([106.0, 108.0]), 0.01)
     samples, _ = _sample(problem, 1500, seed=5)
     points, weights = _posterior_on_grid(problem, [np.linspace(-0.2, 0.6, 121), np.linspace(-0.2, 0.6, 121),
                                                    np.linspace(-3.0, 2.5, 80)])
@@ -83,7 +76,7 @@ def test_two_mode_posterior_is_found_in_the_right_proportion():
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2 + 5.0 * t[:, 0],
                                                           80 + 20 * t[:, 0] ** 2]),
                                ["a"], [-1], [1], 0.01 * np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([118.0, 87.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([118.0, 87.0]), 0.01)
     samples, _ = _sample(problem, 1500, seed=7)
     points, weights = _posterior_on_grid(problem, [np.linspace(-1, 1, 2001), np.linspace(-3.0, 2.5, 120)])
     exact_positive = weights[points[:, 0] > 0].sum()
@@ -95,7 +88,7 @@ def test_two_mode_posterior_is_found_in_the_right_proportion():
 def test_lambda_y_prior_is_recovered_when_the_data_say_nothing():
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 0 * t[:, 0], 80 + 0 * t[:, 0]]),
                                ["a"], [0], [1], 1e6 * np.eye(2))  # emulator so uncertain that y is uninformative
-    problem = Problem.build(emulator, ["S"], _observed([100.0, 80.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([100.0, 80.0]), 0.01)
     samples, _ = _sample(problem, 1500, seed=3)
     prior = stats.gamma(LAMBDA_Y_PRIOR[0], scale=1 / LAMBDA_Y_PRIOR[1])
     assert samples["lambda_y"].mean() == pytest.approx(prior.mean(), rel=0.06)
@@ -104,7 +97,7 @@ def test_lambda_y_prior_is_recovered_when_the_data_say_nothing():
 
 def test_same_seed_gives_identical_samples():
     emulator = StandInEmulator(lambda t: 100.0 + 10 * t, ["a", "b"], [0, 0], [1, 1], np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([105.0, 104.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([105.0, 104.0]), 0.01)
     a, _ = _sample(problem, 200, seed=1, n_live=100)
     b, _ = _sample(problem, 200, seed=1, n_live=100)
     pd.testing.assert_frame_equal(a, b)
@@ -126,8 +119,9 @@ def test_calibrate_returns_draws_summary_and_evidence(paper_config):
                                ["A"], [-1], [1], 0.01 * np.eye(2))
     paper_config["inputs"]["A"] = {"min": -1, "max": 1, "unit": "Mbar"}
     paper_config["calibration"].update(n_live=200, n_eff=800, draws=1000)
-    settings = CalibrationSettings.from_config(paper_config, ["S"])
-    samples, summary, info = calibrate(emulator, ["S"], _observed([118.0, 87.2]), settings)
+    settings = calibration_settings(paper_config, ["S"])
+    posterior = calibrate(emulator, ["S"], _observed([118.0, 87.2]), settings)
+    samples, summary, info = posterior.draws, posterior.summary(), posterior.info()
     assert len(samples) == 1000 and set(samples.columns) == {"A", "lambda_y", "log_likelihood"}
     assert list(summary["parameter"]) == ["A", "lambda_y"] and list(summary["unit"]) == ["Mbar", "-"]
     row = summary.set_index("parameter").loc["A"]
@@ -138,7 +132,7 @@ def test_calibrate_returns_draws_summary_and_evidence(paper_config):
 def test_cube_power_of_an_input_not_calibrated_is_an_error_naming_it():
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 10 * t[:, 0], 80 + 0 * t[:, 0]]), ["a"], [0], [1],
                                np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([105.0, 80.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([105.0, 80.0]), 0.01)
     np.testing.assert_array_equal(problem.cube_power({"a": 2.0}), [2.0, 1.0])
     with pytest.raises(InputError, match=r"cube_power names \['m'\], not among the calibrated inputs \['a'\]"):
         problem.cube_power({"m": 2.0})
@@ -152,7 +146,7 @@ def test_non_finite_likelihood_is_an_error_naming_the_point():
         return mean
 
     emulator = StandInEmulator(broken, ["a"], [0], [1], np.eye(2))
-    problem = Problem.build(emulator, ["S"], _observed([105.0, 80.0]), 0.01)
+    problem = Problem.for_shots(emulator, ["S"], _observed([105.0, 80.0]), 0.01)
     with pytest.raises(InputError, match=r"not finite at \{'a': 0\.75"):
         problem.log_likelihood(np.array([[0.25, 1.0], [0.75, 1.0]]))
     with pytest.raises(InputError, match="not finite"):

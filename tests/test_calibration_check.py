@@ -11,19 +11,12 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from shockcal.calibration import (
-    CalibrationSettings,
-    HydroTruths,
-    Problem,
-    calibrate,
-    coverage_table,
-    hpd_mass,
-    joint_coverage,
-    log_density,
-    synthetic_truth,
-)
+from shockcal.calibration import calibrate
+from shockcal.coverage import HydroTruths, coverage_table, hpd_mass, joint_coverage, synthetic_truth
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
+from shockcal.problem import Problem, log_density
+from shockcal.study.adapters import calibration_settings
 
 FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
 SHOT_INPUTS = {"104S": ["A", "B", "C", "n", "m", "V1", "G1"],
@@ -82,7 +75,7 @@ def mid_box(emulator, shots) -> dict:
 
 def _settings(config, n_live=None, n_eff=None):
     """The config's calibration settings, the sampler's live points and ESS replaced when given."""
-    settings = CalibrationSettings.from_config(config, ["toy"])
+    settings = calibration_settings(config, ["toy"])
     return settings.with_sampler(n_live=n_live or settings.sampler.n_live, n_eff=n_eff or settings.sampler.n_eff)
 
 
@@ -106,7 +99,7 @@ def test_log_posterior_matches_the_gaussian_formula(small_config):
     names = emu.required_inputs(["104S"])
     lo, hi = emu.input_bounds(names)
     theta = (lo + hi) / 2
-    problem = Problem.build(emu, ["104S"], observed_at(emu, ["104S"], dict(zip(names, theta * 1.01))), 0.01)
+    problem = Problem.for_shots(emu, ["104S"], observed_at(emu, ["104S"], dict(zip(names, theta * 1.01))), 0.01)
     lam = 2.0
     mean, cov = emu.predict(dict(zip(names, theta[:, None])), ["104S"])
     total = cov[0] + np.diag((0.01 * problem.observed) ** 2) / lam
@@ -123,7 +116,7 @@ def test_shot_without_emulator_is_rejected(small_config):
     emu = ShotEmulator(small_config, shots=["104S"])
     obs = pd.DataFrame([{"shot": "106S", **dict.fromkeys(FEATURES, 100.0)}])
     with pytest.raises(InputError, match="no shot"):
-        calibrate(emu, ["106S"], obs, CalibrationSettings.from_config(small_config, ["106S"]))
+        calibrate(emu, ["106S"], obs, calibration_settings(small_config, ["106S"]))
 
 
 def test_synthetic_truth_table_and_binomial_band(three_toy_trials):

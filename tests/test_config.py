@@ -9,8 +9,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shockcal.config import load_config, shot_config, validate_config
 from shockcal.errors import ConfigError
+from shockcal.study.config import shot_config
+from shockcal.study.validate import load_config, validate_config
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -96,7 +97,7 @@ def test_unreadable_files(tmp_path):
 
 def test_the_library_validates_a_config_without_snakemake():
     """A notebook user needs neither snakemake installed nor imported: the schema check is jsonschema's."""
-    code = ("import sys; from shockcal.config import load_config; import shockcal.cli, shockcal.simulate; "
+    code = ("import sys; from shockcal.study.validate import load_config; import shockcal.cli, shockcal.simulate; "
             "load_config('config/config.yaml'); print(sorted(m for m in sys.modules if m.startswith('snakemake')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=REPO)
     assert out.stdout.strip() == "[]"
@@ -106,8 +107,8 @@ def test_hydro_settings_defaults_are_the_schemas():
     """`HydroSettings()` (the notebook default) and a config that leaves the numerics out agree."""
     from dataclasses import asdict
 
-    from shockcal.config import SCHEMA_PATH
     from shockcal.hydro import HydroSettings
+    from shockcal.study.validate import SCHEMA_PATH
 
     schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]["hydro"]["properties"]
     defaults = {k: v["default"] for k, v in schema.items() if "default" in v}
@@ -118,8 +119,8 @@ def test_extractor_settings_defaults_are_the_schemas():
     """`ExtractorSettings()` (the notebook default) and a config that leaves the extractor out agree."""
     from dataclasses import asdict
 
-    from shockcal.config import SCHEMA_PATH
     from shockcal.features import ExtractorSettings
+    from shockcal.study.validate import SCHEMA_PATH
 
     schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]
     sections = [schema["features"], schema["shots"]["additionalProperties"]["properties"]["analysis"]]

@@ -4,9 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.config import prior_bounds
-from shockcal.design import ShotMapping, chunk_fingerprints, latin_hypercube, load_design
+from shockcal.design import chunk_fingerprints, latin_hypercube
 from shockcal.errors import InputError
+from shockcal.study.adapters import input_box, load_study_design, shot_mapping
+from shockcal.study.config import prior_bounds
 
 
 def test_latin_hypercube_fills_the_box_one_point_per_stratum(paper_config):
@@ -26,17 +27,17 @@ def test_latin_hypercube_is_reproducible_and_seed_dependent(paper_config):
 def test_shot_mapping_sums_shear_modulus_terms(paper_config):
     row = {"A": 0.002, "B": 0.004, "C": 0.01, "n": 0.5, "m": 1.0, "V1": 0.0204, "V2": 0.0355,
            "V3": 0.0484, "G1": 0.27, "Delta2": 0.01, "Delta3": 0.02}
-    p104 = ShotMapping.from_config(paper_config, "104S").parameters(row)
-    p106 = ShotMapping.from_config(paper_config, "106S").parameters(row)
-    assert p104.velocity_cm_us == 0.0204 and p104.shear_modulus_Mbar == pytest.approx(0.27)
-    assert p106.velocity_cm_us == 0.0484 and p106.shear_modulus_Mbar == pytest.approx(0.30)
+    p104 = shot_mapping(paper_config, "104S").parameters(row)
+    p106 = shot_mapping(paper_config, "106S").parameters(row)
+    assert p104.table_iv().velocity_cm_us == 0.0204 and p104.table_iv().shear_modulus_Mbar == pytest.approx(0.27)
+    assert p106.table_iv().velocity_cm_us == 0.0484 and p106.table_iv().shear_modulus_Mbar == pytest.approx(0.30)
 
 
 def test_load_design_reads_csv_and_adds_run(tmp_path, paper_config):
     design = latin_hypercube(prior_bounds(paper_config), 5, seed=1).drop(columns="run")
     path = tmp_path / "d.csv"
     design.to_csv(path, index=False)
-    loaded = load_design(path, paper_config)
+    loaded = load_study_design(path, paper_config)
     assert list(loaded["run"]) == [0, 1, 2, 3, 4]
     np.testing.assert_allclose(loaded["A"], design["A"])
 
@@ -51,16 +52,16 @@ def test_load_design_rejects_bad_tables_naming_row_and_parameter(tmp_path, paper
     path = tmp_path / "bad.csv"
     mutate(latin_hypercube(prior_bounds(paper_config), 3, seed=1)).to_csv(path, index=False)
     with pytest.raises(InputError, match=message) as err:
-        load_design(path, paper_config)
+        load_study_design(path, paper_config)
     assert "bad.csv" in str(err.value)
 
 
 def test_non_positive_shot_velocity_is_rejected_before_running(paper_config):
     design = latin_hypercube(prior_bounds(paper_config), 3, seed=1)
     design.loc[2, "V2"] = 0.0
-    ShotMapping.from_config(paper_config, "104S").check_positive(design, "d.csv")  # 104S does not use V2
+    shot_mapping(paper_config, "104S").check_positive(design, "d.csv")  # 104S does not use V2
     with pytest.raises(InputError, match="run 2: impact velocity V2"):
-        ShotMapping.from_config(paper_config, "105S").check_positive(design, "d.csv")
+        shot_mapping(paper_config, "105S").check_positive(design, "d.csv")
 
 
 def test_design_depends_on_inputs_and_seed_not_on_their_order(paper_config):
@@ -80,8 +81,8 @@ def test_write_design_rewrites_only_changed_rows(paper_config, tmp_path):
     from shockcal.design import write_design
 
     design, path = latin_hypercube(prior_bounds(paper_config), 6, seed=1), tmp_path / "design.parquet"
-    assert write_design(design, "Latin hypercube, seed 1", paper_config, path)
-    assert not write_design(design.copy(), "file saved.csv", paper_config, path)
+    assert write_design(design, "Latin hypercube, seed 1", input_box(paper_config), path)
+    assert not write_design(design.copy(), "file saved.csv", input_box(paper_config), path)
     grown = pd.concat([design, latin_hypercube(prior_bounds(paper_config), 1, seed=2).assign(run=6)], ignore_index=True)
-    assert write_design(grown, "file saved.csv", paper_config, path)
+    assert write_design(grown, "file saved.csv", input_box(paper_config), path)
     assert pd.read_parquet(path).equals(grown[["run", *design.columns[1:]]])

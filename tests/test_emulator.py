@@ -6,10 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.config import prior_bounds
-from shockcal.emulator import CALIBRATION_FEATURES, Emulator, EmulatorSpec, fit_emulator, rmse_table
+from shockcal.emulator import Emulator, fit_emulator, rmse_table
 from shockcal.errors import InputError
+from shockcal.features import CALIBRATION_FEATURES
 from shockcal.gp import GaussianProcess
+from shockcal.study.adapters import emulator_spec
+from shockcal.study.config import prior_bounds
 
 NOISE = 0.05
 
@@ -63,7 +65,7 @@ def _synthetic_study(paper_config, n=60, seed=3):
 def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
     design, features, _ = _synthetic_study(paper_config, n=90)
     paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
-    emulator = fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
+    emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
     table = rmse_table(emulator.cv_table())
     overall = table.iloc[-1]
     assert overall["rmse_m_s"] < 3 * NOISE
@@ -79,7 +81,7 @@ def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path
     design, features, _ = _synthetic_study(paper_config, n=30)
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(design, {"104S": features, "106S": features},
-                            EmulatorSpec.from_config(paper_config, ["104S", "106S"]))
+                            emulator_spec(paper_config, ["104S", "106S"]))
     loaded = Emulator.load(emulator.save(tmp_path / "emu"))
     inputs = {k: design[k].to_numpy()[:5] for k in design.columns}
     for a, b in zip(emulator.predict(inputs, ["106S", "104S"]), loaded.predict(inputs, ["106S", "104S"])):
@@ -100,7 +102,7 @@ def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
     features.loc[0, "status"] = "failed"
     features.loc[1, "v_plastic"] = np.nan
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
-    emulator = fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
+    emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
     assert len(emulator.blocks[0].runs) == 28
     assert "2 of 30 runs dropped" in caplog.text
 
@@ -114,7 +116,7 @@ def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
 def test_bad_training_sets_are_rejected(paper_config, mutate, message):
     design, features = mutate(*_synthetic_study(paper_config, n=30)[:2])
     with pytest.raises(InputError, match=message):
-        fit_emulator(design, {"104S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
+        fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
 
 
 def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
@@ -144,4 +146,4 @@ def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
 def test_features_of_a_shot_the_spec_does_not_map_are_rejected(paper_config):
     design, features, _ = _synthetic_study(paper_config, n=30)
     with pytest.raises(InputError, match=r"features of shots \['106S'\]: the emulator spec maps only \['104S'\]"):
-        fit_emulator(design, {"104S": features, "106S": features}, EmulatorSpec.from_config(paper_config, ["104S"]))
+        fit_emulator(design, {"104S": features, "106S": features}, emulator_spec(paper_config, ["104S"]))

@@ -1,13 +1,14 @@
 """PCGPEmulator on plain arrays: each correlation family recovers a known map with calibrated bands;
-K-fold equals brute-force refits; save/load; `shockcal emulate-predict`."""
+K-fold equals brute-force refits; save/load; `shockcal predict-emulator`."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from shockcal.correlation import FAMILIES, family_code, value_and_slope
-from shockcal.emulator import PCGPEmulator, Settings, Switch
 from shockcal.gp import GaussianProcess
+from shockcal.pcgp import PCGPEmulator, Settings, Switch
+from shockcal.study.adapters import emulator_spec
 
 NOISE = 0.05
 
@@ -152,20 +153,21 @@ def test_arrays_api_fits_predicts_saves_and_loads(tmp_path):
     assert set(outer.rows) == set(np.flatnonzero(np.any((x < 0.1) | (x > 0.9), axis=1)))
 
 
-def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_config):
+def test_predict_emulator_writes_every_run_shot_and_feature(tmp_path, paper_config):
     import yaml
 
     from shockcal.cli import main
-    from shockcal.config import prior_bounds
     from shockcal.design import latin_hypercube
-    from shockcal.emulator import CALIBRATION_FEATURES, Emulator, EmulatorSpec, fit_emulator
+    from shockcal.emulator import Emulator, fit_emulator
+    from shockcal.features import CALIBRATION_FEATURES
+    from shockcal.study.config import prior_bounds
 
     design = latin_hypercube(prior_bounds(paper_config), 30, 1)
     features = pd.DataFrame({f: 100 + 50 * design["A"] / 0.01 + 10 * i + 1e3 * design["V1"]
                              for i, f in enumerate(CALIBRATION_FEATURES)}).assign(run=design["run"])
     paper_config["emulator"].update(n_starts=1, calibrate_sd=False)
     emulator = fit_emulator(design, {"104S": features, "105S": features},
-                            EmulatorSpec.from_config(paper_config, ["104S", "105S"]))
+                            emulator_spec(paper_config, ["104S", "105S"]))
     input_map = emulator.blocks[0].input_map
     strain, temperature = (paper_config["emulator"][k] for k in ("hardening_strain", "homologous_temperature"))
     np.testing.assert_allclose(input_map.raw(design)[:, -2:], np.column_stack([strain ** design["n"],
@@ -175,14 +177,14 @@ def test_emulate_predict_writes_every_run_shot_and_feature(tmp_path, paper_confi
     new = latin_hypercube(prior_bounds(paper_config), 7, 2).assign(run=lambda d: d["run"] + 100)
     new.to_csv(tmp_path / "new.csv", index=False)
     (tmp_path / "c.yaml").write_text(yaml.safe_dump(paper_config))
-    assert main(["emulate-predict", "--config", str(tmp_path / "c.yaml"), "--emulator", str(tmp_path / "emu"),
+    assert main(["predict-emulator", "--config", str(tmp_path / "c.yaml"), "--emulator", str(tmp_path / "emu"),
                  "--design", str(tmp_path / "new.csv"), "--out", str(tmp_path / "p.parquet")]) == 0
     table = pd.read_parquet(tmp_path / "p.parquet")
-    assert list(table.columns) == ["run", "shot", "feature", "mean", "sd"]
-    assert len(table) == 7 * 2 * 4 and set(table["run"]) == set(new["run"])
+    assert list(table.columns) == ["run", "shot", *CALIBRATION_FEATURES, *(f"{f}_sd" for f in CALIBRATION_FEATURES)]
+    assert len(table) == 7 * 2 and set(table["run"]) == set(new["run"])
     mean, cov = Emulator.load(tmp_path / "emu").predict({k: new[k].to_numpy() for k in new.columns}, ["105S"])
-    row = table[(table["run"] == 103) & (table["shot"] == "105S") & (table["feature"] == "v_slope1")].iloc[0]
-    assert row["mean"] == pytest.approx(mean[3, 2]) and row["sd"] == pytest.approx(np.sqrt(cov[3, 2, 2]))
+    row = table[(table["run"] == 103) & (table["shot"] == "105S")].iloc[0]
+    assert row["v_slope1"] == pytest.approx(mean[3, 2]) and row["v_slope1_sd"] == pytest.approx(np.sqrt(cov[3, 2, 2]))
 
 
 def test_same_seed_gives_the_same_emulator_and_another_seed_another_fit_subset():

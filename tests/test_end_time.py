@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.config import AUTO_END_MARGIN_US, end_time_us
+from shockcal.study.config import AUTO_END_MARGIN_US, end_time_us
 
 DATA = Path(__file__).with_name("data")
 sys.path.insert(0, str(DATA))

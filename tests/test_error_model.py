@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from shockcal.calibration import Problem
-from shockcal.emulator import PCGPEmulator, Settings
 from shockcal.error_model import ErrorModel
+from shockcal.pcgp import PCGPEmulator, Settings
+from shockcal.problem import Problem
 
 
 def _spd(rng, f):

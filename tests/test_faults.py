@@ -16,15 +16,17 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.calibration import CalibrationSettings, calibrate
+from shockcal.calibration import calibrate
 from shockcal.cli import main, parse_pairs, parse_span
-from shockcal.config import load_config, prior_bounds, validate_config
-from shockcal.design import ShotMapping, latin_hypercube, load_design
+from shockcal.design import latin_hypercube
 from shockcal.error_model import ErrorModel
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.features import check_failures
 from shockcal.io import atomic_path, read_table, write_table
 from shockcal.records import OPT_OUT, read_record
+from shockcal.study.adapters import calibration_settings, load_study_design, shot_mapping
+from shockcal.study.config import prior_bounds
+from shockcal.study.validate import load_config, validate_config
 
 REPO = Path(__file__).resolve().parents[1]
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -62,7 +64,7 @@ def test_design_faults(tmp_path, paper_config, fault):
     mutate, fragments = DESIGN_FAULTS[fault]
     path = _design(tmp_path, paper_config, mutate)
     with pytest.raises(InputError) as err:
-        load_design(path, paper_config)
+        load_study_design(path, paper_config)
     for fragment in [str(path), *fragments]:
         assert fragment in str(err.value)
 
@@ -71,10 +73,10 @@ def test_design_unreadable_and_non_positive_velocity(tmp_path, paper_config):
     path = tmp_path / "design.csv"
     path.write_bytes(os.urandom(2000))
     with pytest.raises(InputError, match=f"table {path} could not be read"):
-        load_design(path, paper_config)
+        load_study_design(path, paper_config)
     design = latin_hypercube(prior_bounds(paper_config), 3, seed=1).assign(V2=0.0)
     with pytest.raises(InputError, match="d.csv: run 0: impact velocity V2 = 0.0 must be positive for shot 105S"):
-        ShotMapping.from_config(paper_config, "105S").check_positive(design, "d.csv")
+        shot_mapping(paper_config, "105S").check_positive(design, "d.csv")
 
 
 def test_design_file_in_config_is_checked_at_load(tmp_path, paper_config):
@@ -87,7 +89,7 @@ def test_design_file_in_config_is_checked_at_load(tmp_path, paper_config):
 def test_design_outside_box_is_accepted_when_said_so(tmp_path, paper_config, caplog):
     paper_config["checks"]["design_box"] = False
     path = _design(tmp_path, paper_config, DESIGN_FAULTS["outside-box"][0])
-    assert load_design(path, paper_config)["m"][1] == 3.5
+    assert load_study_design(path, paper_config)["m"][1] == 3.5
     assert "accepted: checks.design_box: false" in caplog.text
 
 
@@ -225,7 +227,7 @@ OBSERVED_FAULTS = {
 def test_observed_table_faults(paper_config, fault):
     table, fragments = OBSERVED_FAULTS[fault]
     with pytest.raises(InputError) as err:
-        calibrate(StandInEmulator(), ["104S"], table, CalibrationSettings.from_config(paper_config, ["104S"]),
+        calibrate(StandInEmulator(), ["104S"], table, calibration_settings(paper_config, ["104S"]),
                   source="obs.csv")
     for fragment in ["obs.csv", *fragments]:
         assert fragment in str(err.value)

@@ -12,7 +12,6 @@ from scipy.stats import norm
 from shockcal.errors import InputError
 from shockcal.features import (
     COLUMNS,
-    ExtractorSettings,
     Mixture,
     extract_features,
     feature_values,
@@ -21,6 +20,7 @@ from shockcal.features import (
     split_early,
 )
 from shockcal.records import read_record
+from shockcal.study.adapters import extractor_settings
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "al5083"   # the shipped records and published features
 
@@ -72,7 +72,7 @@ GRID_STEP = 0.0005
 
 @pytest.fixture
 def settings(paper_config):
-    return ExtractorSettings.from_config(paper_config, SHOT)
+    return extractor_settings(paper_config, SHOT)
 
 
 def features(v, settings):
@@ -98,7 +98,7 @@ def test_a_weak_precursor_of_a_trace_at_rest_is_the_arrival(paper_config):
     the 2% arrival level a noisy record needs. A trace exactly at rest before it (a simulation)
     takes the precursor as the arrival, so the elastic plateau is the precursor, not the wave."""
     v = 6.0 * norm.cdf((T - 0.90) / 0.004) + 464.0 * norm.cdf((T - 1.00) / 0.01)
-    f = extract_features(T, v, ExtractorSettings.from_config(paper_config, "106S"))
+    f = extract_features(T, v, extractor_settings(paper_config, "106S"))
     assert f["t_jumpoff"] == pytest.approx(0.90 + 0.004 * norm.ppf(0.01), abs=1e-3)
     assert f["v_elastic"] == pytest.approx(6.0 * 0.99, abs=0.1)
     assert f["v_plastic"] > 460
@@ -150,15 +150,14 @@ def test_features_are_a_deterministic_and_stable_function_of_the_trace(settings,
 def test_neighbouring_hydrocode_runs_have_neighbouring_features(paper_config):
     """106S at C near 0 (where the old seeded extractor moved v_slope1 by 6 m/s between near-identical
     runs): two runs 1e-4 apart in C give slope velocities within 0.5 m/s."""
-    from shockcal.design import ShotParameters
-    from shockcal.hydro import run_shot
-    from shockcal.simulate import hydro_inputs
+    from shockcal.hydro import ShotParameters, run_shot
+    from shockcal.study.adapters import hydro_inputs
 
     paper_config["hydro"]["end_time_us"] = 2.1
     shot = paper_config["shots"]["106S"]
-    runs = [run_shot(ShotParameters(0.0035, 0.004, C, 0.3, 1.0, 0.0484, 0.33), *hydro_inputs(paper_config, shot))
+    runs = [run_shot(ShotParameters.from_table_iv(0.0035, 0.004, C, 0.3, 1.0, 0.0484, 0.33), *hydro_inputs(paper_config, shot))
             for C in (0.0010, 0.0011)]
-    settings = ExtractorSettings.from_config(paper_config, "106S")
+    settings = extractor_settings(paper_config, "106S")
     first, second = (extract_features(r.t_us, r.v_m_s, settings) for r in runs)
     for column in ("v_elastic", "v_slope1", "v_slope2", "v_plastic"):
         assert abs(first[column] - second[column]) < 0.5, column
@@ -254,7 +253,7 @@ def test_record_with_unnamed_columns_asks_for_names(tmp_path):
 def test_record_without_a_rise_names_the_file(tmp_path, paper_config):
     path = write_trace(tmp_path / "flat.csv", ["t_us,v_m_s"], [[t, 1.5] for t in T])
     with pytest.raises(InputError, match=re.escape(f"record {path}: no features for shot {SHOT}: no rise")):
-        record_features(path, ExtractorSettings.from_config(paper_config, SHOT), SHOT)
+        record_features(path, extractor_settings(paper_config, SHOT), SHOT)
 
 
 def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config):
@@ -267,7 +266,7 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
         "t_us": [T, T, T, T, np.array([])],
         "v_m_s": [trace(noise_sd=1.0), trace(), np.zeros(T.size), broken, np.array([])],
     })
-    settings = ExtractorSettings.from_config(paper_config, SHOT)
+    settings = extractor_settings(paper_config, SHOT)
     table = features_table(traces, settings)
     assert list(table.columns) == ["run", "status", "reason", *COLUMNS]
     assert table["run"].tolist() == [0, 1, 2, 3, 4]
@@ -313,7 +312,7 @@ def record_differences(paper_config_readonly):
     published = pd.read_csv(DATA / "observed_features.csv").set_index("shot")
     return {shot: {column: value - published.loc[shot, column]
                    for column, value in record_features(DATA / "visar" / f"Data_S{shot}.txt",
-                                                        ExtractorSettings.from_config(paper_config_readonly, shot),
+                                                        extractor_settings(paper_config_readonly, shot),
                                                         shot).items()}
             for shot in BOUNDS}
 

@@ -11,9 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.design import ShotMapping
-from shockcal.features import ExtractorSettings, features_table
-from shockcal.simulate import hydro_inputs, simulate_design
+from shockcal.features import features_table
+from shockcal.simulate import simulate_design
+from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
 
 # The ten 104S runs (A 390-950 MPa: one merged wave) where a cut-off 80 ns after arrival put a broad
 # second component into the elastic mixture: v_elastic 16-33 m/s above FLAG's (RMSE 22 m/s), v_slope1 13-28.
@@ -26,9 +26,9 @@ def errors_against_flag(reference_data, config, shot, runs) -> tuple[pd.DataFram
     """(our features, FLAG's) for the given design runs of one shot, indexed by run."""
     design = pd.read_csv(reference_data / "design.csv")
     flag = pd.read_csv(reference_data / f"flag_features_{shot}.csv").set_index("run")
-    traces = simulate_design(design[design["run"].isin(runs)], ShotMapping.from_config(config, shot),
+    traces = simulate_design(design[design["run"].isin(runs)], shot_mapping(config, shot),
                              *hydro_inputs(config, config["shots"][shot]))
-    ours = features_table(traces, ExtractorSettings.from_config(config, shot)).set_index("run")
+    ours = features_table(traces, extractor_settings(config, shot)).set_index("run")
     assert (ours["status"] == "ok").all(), ours.loc[ours["status"] != "ok", "reason"]
     return ours, flag.loc[ours.index]
 

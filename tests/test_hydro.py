@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from shockcal.design import ShotParameters
-from shockcal.hydro import run_shot
+from shockcal.hydro import ShotParameters, run_shot
 from shockcal.hydro.strength import (
     flow_stress,
     hardening,
@@ -19,7 +18,7 @@ from shockcal.hydro.strength import (
     thermal_factor,
     thermal_factor_below,
 )
-from shockcal.simulate import hydro_inputs
+from shockcal.study.adapters import hydro_inputs
 
 DATA = Path(__file__).parent / "data"
 
@@ -52,7 +51,7 @@ def _arrival(t, v, level):
 
 @pytest.mark.parametrize("velocity", [0.0204, 0.03549, 0.04838])
 def test_no_strength_plateau_and_shock_speed(paper_config, velocity):
-    params = ShotParameters(0.0, 0.0, 0.0, 0.0, 0.0, velocity, G)
+    params = ShotParameters.from_table_iv(0.0, 0.0, 0.0, 0.0, 0.0, velocity, G)
     arrivals = []
     for target_mm in (1.0, 2.0):
         shot = _setup(paper_config, 3.0, target_mm, 0.9)
@@ -103,7 +102,7 @@ def _precursor(config, cell_size_um, target_mm, Y=0.003, C=0.0):
     _, c_long = _elastic_reference(config, Y)
     t_elastic = target_mm * 0.1 / c_long
     shot = _setup(config, 2.0, target_mm, t_elastic + 0.05, cell_size_um)
-    result = run_shot(ShotParameters(Y, 0.0, C, 0.0, 1.0, 0.0204, G), *hydro_inputs(config, shot))
+    result = run_shot(ShotParameters.from_table_iv(Y, 0.0, C, 0.0, 1.0, 0.0204, G), *hydro_inputs(config, shot))
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s
     amplitude = np.median(v[(t > t_elastic + 0.02) & (t < t_elastic + 0.045)])
@@ -136,7 +135,7 @@ def test_mesh_convergence(paper_config):
 
 def test_energy_conserved(paper_config):
     shot = _setup(paper_config, 1.0, 1.5, 0.5)
-    result = run_shot(ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, G), *hydro_inputs(paper_config, shot))
+    result = run_shot(ShotParameters.from_table_iv(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, G), *hydro_inputs(paper_config, shot))
     assert result.status == "ok", result.reason
     assert result.energy_error < 1e-3
 
@@ -144,7 +143,7 @@ def test_energy_conserved(paper_config):
 def test_numerical_failure_is_reported(paper_config):
     paper_config["hydro"]["cfl"] = 3.0                 # unstable on purpose
     shot = _setup(paper_config, 0.5, 0.5, 0.2)
-    result = run_shot(ShotParameters(0.001, 0.0, 0.0, 0.0, 1.0, 0.0204, G), *hydro_inputs(paper_config, shot))
+    result = run_shot(ShotParameters.from_table_iv(0.001, 0.0, 0.0, 0.0, 1.0, 0.0204, G), *hydro_inputs(paper_config, shot))
     assert result.status == "failed"
     assert "cell" in result.reason and "t =" in result.reason
 
@@ -167,8 +166,8 @@ def test_strength_conventions():
 @pytest.mark.parametrize("path, value", [(("shots", "104S", "flyer_mm"), 0.0), (("shots", "105S", "target_mm"), -1.0),
                                          (("hydro", "cell_size_um"), 0.0)])
 def test_non_positive_geometry_is_a_config_error(paper_config, path, value):
-    from shockcal.config import validate_config
     from shockcal.errors import ConfigError
+    from shockcal.study.validate import validate_config
 
     node = paper_config
     for key in path[:-1]:
@@ -202,8 +201,8 @@ def test_one_cell_at_constant_rate_flows_at_the_rate_term(C, rate_per_s):
 def test_c0_traces_identical_to_the_lagged_rate_code(paper_config):
     """C = 0 makes the rate convention irrelevant: traces stored before the rate change are reproduced bit for bit."""
     stored = np.load(DATA / "c0_traces_before_rate_change.npz")
-    cases = {"gray_c0_104": ShotParameters(0.0017, 0.00425, 0.0, 0.42, 1.225, 0.0204, 0.27),
-             "hard_c0_106": ShotParameters(0.004, 0.002, 0.0, 0.2, 0.8, 0.04838, 0.33)}
+    cases = {"gray_c0_104": ShotParameters.from_table_iv(0.0017, 0.00425, 0.0, 0.42, 1.225, 0.0204, 0.27),
+             "hard_c0_106": ShotParameters.from_table_iv(0.004, 0.002, 0.0, 0.2, 0.8, 0.04838, 0.33)}
     shot = _setup(paper_config, 1.0, 1.5, 0.6)
     for name, params in cases.items():
         result = run_shot(params, *hydro_inputs(paper_config, shot))
@@ -215,11 +214,11 @@ def test_flow_stress_floors_change_no_trace(paper_config):
     bound of its flow stress (the flow-stress floors, 2026-11-24): traces stored from the code before
     them (rate term on, small m, n = 0, strong and hot cases) are reproduced bit for bit."""
     stored = np.load(DATA / "traces_before_flow_floors.npz")
-    cases = {"gray_104": ShotParameters(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),
-             "soft_m_106": ShotParameters(0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30),
-             "n0_105": ShotParameters(0.0072, 0.003, 0.0159, 0.0, 1.10, 0.03549, 0.28),
-             "rate_hot_106": ShotParameters(0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),
-             "strong_104": ShotParameters(0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
+    cases = {"gray_104": ShotParameters.from_table_iv(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),
+             "soft_m_106": ShotParameters.from_table_iv(0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30),
+             "n0_105": ShotParameters.from_table_iv(0.0072, 0.003, 0.0159, 0.0, 1.10, 0.03549, 0.28),
+             "rate_hot_106": ShotParameters.from_table_iv(0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),
+             "strong_104": ShotParameters.from_table_iv(0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
     shot = _setup(paper_config, 1.0, 1.5, 0.6)
     for name, params in cases.items():
         assert np.array_equal(run_shot(params, *hydro_inputs(paper_config, shot)).v_m_s, stored[name]), name

@@ -10,10 +10,10 @@ import pandas as pd
 import pytest
 from matplotlib.image import imread
 
-from shockcal.config import input_names
-from shockcal.design import ShotMapping
 from shockcal.plots import crossval, feature_space, histories, posterior, records, toys
 from shockcal.plots.style import CALIBRATION_FEATURES, FEATURES, save_figure
+from shockcal.study.adapters import shot_mapping
+from shockcal.study.config import input_names
 
 SHOTS = ["104S", "105S", "106S"]
 
@@ -94,7 +94,7 @@ def small_config(paper_config):
 
 
 def test_marginals(paper_config, small_config, tmp_path):
-    posts = {s: _posterior(paper_config, ShotMapping.from_config(paper_config, s).inputs()[:6]) for s in SHOTS}
+    posts = {s: _posterior(paper_config, shot_mapping(paper_config, s).inputs()[:6]) for s in SHOTS}
     posts["joint"] = _posterior(paper_config, input_names(paper_config))
     small_config["inputs"]["V2"] = paper_config["inputs"]["V2"]
     fig = posterior.fig07_marginals(posts, small_config)

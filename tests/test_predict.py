@@ -9,10 +9,10 @@ import pandas as pd
 import pytest
 
 from shockcal.cli import main
-from shockcal.config import input_names
 from shockcal.errors import InputError
 from shockcal.io import read_table, write_table
 from shockcal.predict import draw_posterior_design
+from shockcal.study.config import input_names
 
 CONFIG = str(Path(__file__).resolve().parents[1] / "config" / "config.yaml")
 
@@ -28,24 +28,24 @@ def _posterior(config, n):
 
 def test_draws_are_posterior_rows_shaped_like_a_design(paper_config):
     post = _posterior(paper_config, 500)
-    design = draw_posterior_design(post, paper_config, 100, seed=3)
+    design = draw_posterior_design(post, input_names(paper_config), 100, seed=3)
     assert list(design.columns) == ["run", *input_names(paper_config)]
     assert design["run"].tolist() == list(range(100))
     assert len(design.merge(post, on=input_names(paper_config))) == 100  # every row is a posterior sample
     assert not design.duplicated(input_names(paper_config)).any()
-    pd.testing.assert_frame_equal(design, draw_posterior_design(post, paper_config, 100, seed=3))
-    assert not design.equals(draw_posterior_design(post, paper_config, 100, seed=4))
+    pd.testing.assert_frame_equal(design, draw_posterior_design(post, input_names(paper_config), 100, seed=3))
+    assert not design.equals(draw_posterior_design(post, input_names(paper_config), 100, seed=4))
 
 
 def test_small_posterior_is_drawn_with_replacement(paper_config):
-    assert len(draw_posterior_design(_posterior(paper_config, 10), paper_config, 30, seed=0)) == 30
+    assert len(draw_posterior_design(_posterior(paper_config, 10), input_names(paper_config), 30, seed=0)) == 30
 
 
 def test_empty_or_single_shot_posterior_is_refused(paper_config):
     with pytest.raises(InputError, match="post.parquet: posterior has no samples"):
-        draw_posterior_design(_posterior(paper_config, 0), paper_config, 5, 0, source="post.parquet")
+        draw_posterior_design(_posterior(paper_config, 0), input_names(paper_config), 5, 0, source="post.parquet")
     with pytest.raises(InputError, match="missing column.*V2"):
-        draw_posterior_design(_posterior(paper_config, 50).drop(columns=["V2"]), paper_config, 5, 0)
+        draw_posterior_design(_posterior(paper_config, 50).drop(columns=["V2"]), input_names(paper_config), 5, 0)
 
 
 def test_cli_writes_the_design(paper_config, tmp_path, capsys):
@@ -75,7 +75,7 @@ class _LinearEmulator:
 def test_emulator_predictions_one_row_per_run_and_shot(paper_config):
     from shockcal.predict import emulator_predictions
 
-    design = draw_posterior_design(_posterior(paper_config, 50), paper_config, 10, seed=0)
+    design = draw_posterior_design(_posterior(paper_config, 50), input_names(paper_config), 10, seed=0)
     table = emulator_predictions(_LinearEmulator(), design, ["104S", "105S"])
     assert len(table) == 20 and set(table["shot"]) == {"104S", "105S"}
     row = table[(table["shot"] == "105S") & (table["run"] == 3)].iloc[0]

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from shockcal.study.adapters import extractor_settings
+
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
@@ -21,20 +23,21 @@ def _run_block(index: int) -> dict:
 
 def test_readme_notebook_example_recovers_the_inputs_that_made_the_measurement():
     scope = _run_block(0)
-    summary = scope["summary"].set_index("parameter")
+    posterior = scope["posterior"]
+    summary = posterior.summary().set_index("parameter")
     for name, truth in {"a": 0.4, "b": 0.5}.items():
         assert summary.loc[name, "q05"] < truth < summary.loc[name, "q95"], summary
     assert summary.loc["a", "q95"] - summary.loc["a", "q05"] < 0.25     # the data do inform a
-    assert len(scope["draws"]) == 10000 and scope["info"]["ess_kish"] >= 1500
+    assert len(posterior.draws) == 10000 and posterior.info()["ess_kish"] >= 1500
 
 
 def test_readme_hydrocode_shot_is_the_study_configs_run(paper_config):
     """The two-line shot runs, its plateau is near the impact velocity (symmetric impact), and its defaults
     (Al-5083, the numerics) are the study config's: the same run through the config adapter is
     bit-identical, and so are its features read with the config's 104S settings."""
-    from shockcal.features import ExtractorSettings, extract_features
+    from shockcal.features import extract_features
     from shockcal.hydro import run_shot
-    from shockcal.simulate import hydro_inputs
+    from shockcal.study.adapters import hydro_inputs
 
     scope = _run_block(1)
     result = scope["result"]
@@ -43,8 +46,7 @@ def test_readme_hydrocode_shot_is_the_study_configs_run(paper_config):
     plateau = np.median(v[(t > 1.6) & (t < 2.0)])          # m/s; strength holds it a few % below 204
     assert 0.95 * 204.0 < plateau < 204.0
     spec = {"flyer_mm": 3.95, "target_mm": 5.965}
-    params = scope["ShotParameters"](0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.269)
-    from_config = run_shot(params, *hydro_inputs(paper_config, spec, end_us=2.2))
+    from_config = run_shot(scope["params"], *hydro_inputs(paper_config, spec, end_us=2.2))
     assert np.array_equal(from_config.v_m_s, v)
-    assert scope["features"] == extract_features(t, v, ExtractorSettings.from_config(paper_config, "104S"))
+    assert scope["features"] == extract_features(t, v, extractor_settings(paper_config, "104S"))
     assert scope["features"]["v_elastic"] < scope["features"]["v_plastic"] <= v.max()

@@ -7,9 +7,9 @@ import itertools
 import numpy as np
 import pytest
 
-from shockcal.config import prior_bounds
 from shockcal.design import latin_hypercube
 from shockcal.seeds import STREAMS, stream_seed
+from shockcal.study.config import prior_bounds
 
 
 def test_design_stream_is_the_study_seed_itself(paper_config):

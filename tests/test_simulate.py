@@ -7,9 +7,10 @@ import yaml
 
 from shockcal import hydro
 from shockcal.cli import main
-from shockcal.config import prior_bounds
-from shockcal.design import ShotMapping, latin_hypercube
-from shockcal.simulate import hydro_inputs, simulate_design
+from shockcal.design import latin_hypercube
+from shockcal.simulate import simulate_design
+from shockcal.study.adapters import hydro_inputs, shot_mapping
+from shockcal.study.config import prior_bounds
 
 
 @pytest.fixture
@@ -23,7 +24,7 @@ def coarse_config(paper_config, tmp_path):
 def test_table_has_documented_columns(coarse_config):
     config, _ = coarse_config
     design = latin_hypercube(prior_bounds(config), 2, seed=1)
-    table = simulate_design(design, ShotMapping.from_config(config, "105S"), *hydro_inputs(config, config["shots"]["105S"]))
+    table = simulate_design(design, shot_mapping(config, "105S"), *hydro_inputs(config, config["shots"]["105S"]))
     expected = {"run", "shot", "A", "B", "C", "n", "m", "V2", "G1", "Delta2", "impact_velocity_m_s", "shear_modulus_GPa",
                 "status", "reason", "max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
                 "n_steps", "wall_time_s", "t_us", "v_m_s"}
@@ -38,13 +39,13 @@ def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypa
     real = hydro.run_shot
 
     def flaky(params, *inputs):
-        if params.A == design["A"].iloc[1]:
+        if params.table_iv().A_Mbar == design["A"].iloc[1]:
             raise FloatingPointError("synthetic failure")
         return real(params, *inputs)
 
     design = latin_hypercube(prior_bounds(config), 3, seed=2)
     monkeypatch.setattr("shockcal.simulate.run_shot", flaky)
-    table = simulate_design(design, ShotMapping.from_config(config, "104S"), *hydro_inputs(config, config["shots"]["104S"]))
+    table = simulate_design(design, shot_mapping(config, "104S"), *hydro_inputs(config, config["shots"]["104S"]))
     assert list(table["status"]) == ["ok", "failed", "ok"]
     assert "synthetic failure" in table["reason"].iloc[1]
     assert np.isnan(table["max_temperature_K"].iloc[1])

@@ -1,12 +1,12 @@
-"""shockcal.stages: one declaration of the config keys each stage reads, serving both the rules'
+"""shockcal.study.stages: one declaration of the config keys each stage reads, serving both the rules'
 params and the slice each command hands its library code (issue 15)."""
 from pathlib import Path
 
 import pytest
 
-from shockcal.config import load_config
 from shockcal.plots.catalogue import catalogue
-from shockcal.stages import STAGE_KEYS, config_slice, figure_config, stage_config
+from shockcal.study.stages import STAGE_KEYS, config_slice, figure_config, stage_config
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 

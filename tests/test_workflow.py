@@ -22,8 +22,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.config import load_config
 from shockcal.plots.catalogue import catalogue
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).parent / "snakemake")
@@ -174,7 +174,7 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
 
 def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_path):
     """observed.sd_fraction sets the calibrations' likelihood and Figures 9-10's error bars, and
-    nothing else: the declared slices (shockcal.stages) list it there and only there. Until the
+    nothing else: the declared slices (shockcal.study.stages) list it there and only there. Until the
     declaration the two figures did not list it and were left stale by a change."""
     results, config = study
     wider = overlay(tmp_path / "sd.yaml", observed={"sd_fraction": 0.02})

@@ -3,30 +3,57 @@
 A design table has one row per run: an integer `run` id and one column per calibration input
 (A, B, C, n, m, V1, V2, V3, G1, Delta2, Delta3 for the paper's study) in the box's native units
 (Mbar for A, B and shear moduli; cm/us for velocities; C, n, m dimensionless). One design serves
-every shot: a `ShotMapping` maps a row onto one shot (SPEC section 3).
+every shot: a `ShotMapping` maps a row onto one shot (SPEC section 3). An `InputBox` is the prior
+box a design is checked against (`shockcal.study.adapters.input_box` builds it from a config).
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from shockcal.config import STRENGTH_INPUTS, input_names, prior_bounds, shot_config
 from shockcal.errors import InputError
+from shockcal.hydro import JOHNSON_COOK_INPUTS, ShotParameters
 from shockcal.io import read_table, require_columns
 from shockcal.plausibility import range_problem
-from shockcal.seeds import stream_seed
 
 log = logging.getLogger("shockcal.design")
 
 
+@dataclass(frozen=True)
+class InputBox:
+    """The prior box of the calibration inputs, which a design must lie in.
+
+    Args:
+        bounds: input name -> (min, max) in the input's native unit, in the design's column order.
+        units: input name -> its unit (e.g. "Mbar", "cm/us", "-"), for messages and table metadata.
+        velocity_of: input name -> the shot whose impact velocity it is (names it in messages).
+        strict: whether a design point outside the box stops the load (else a warning;
+            config `checks.design_box`).
+    """
+
+    bounds: Mapping[str, tuple[float, float]]
+    units: Mapping[str, str]
+    velocity_of: Mapping[str, str] = field(default_factory=dict)
+    strict: bool = True
+
+    def names(self) -> list[str]:
+        """The inputs in the box's order (a design table's columns after `run`)."""
+        return list(self.bounds)
+
+
 def latin_hypercube(bounds: Mapping[str, tuple[float, float]], n_runs: int, seed: int) -> pd.DataFrame:
-    """A seeded Latin hypercube of `n_runs` points over a box (input -> (min, max); scipy.stats.qmc).
+    """A seeded Latin hypercube of `n_runs` points over a box (scipy.stats.qmc).
+
+    Args:
+        bounds: input name -> (min, max), native units.
+        n_runs: points (runs) in the design.
+        seed: the hypercube's seed.
 
     The hypercube's dimensions are the inputs in sorted order, so the design depends on the box and
     the seed, not on the order the box lists its inputs (the workflow's jobs read a key-sorted copy
@@ -42,16 +69,19 @@ def latin_hypercube(bounds: Mapping[str, tuple[float, float]], n_runs: int, seed
     return design
 
 
-def load_design(path: str | Path, config: dict, columns: list[str] | None = None) -> pd.DataFrame:
+def load_design(path: str | Path, box: InputBox, columns: list[str] | None = None) -> pd.DataFrame:
     """Read a CSV/Parquet design, check it, and return it with an integer `run` column.
 
-    `columns` are the inputs that must be present (default: all config inputs). Values must be
-    finite; Johnson-Cook inputs non-negative; inside the prior box (`check_design_box`); velocities
-    and shear moduli positive (checked per shot by `ShotMapping.check_positive`). Errors name the
-    file, the row and the parameter.
+    Args:
+        path: the design table (one row per run; `run` is added as 0..N-1 when absent).
+        box: the prior box the design must lie in (`check_design_box`).
+        columns: the inputs that must be present (default: all of the box's).
+
+    Values must be finite; Johnson-Cook inputs non-negative; velocities and shear moduli positive
+    (checked per shot by `ShotMapping.check_positive`). Errors name the file, the row and the parameter.
     """
     design = read_table(path)
-    columns = input_names(config) if columns is None else columns
+    columns = box.names() if columns is None else columns
     require_columns(design, columns, path)
     if "run" not in design.columns:
         design.insert(0, "run", np.arange(len(design), dtype=np.int64))
@@ -65,45 +95,32 @@ def load_design(path: str | Path, config: dict, columns: list[str] | None = None
             row = design.loc[bad, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({design.loc[bad, name].iloc[0]!r})")
         design[name] = values.astype(float)
-        if name in STRENGTH_INPUTS and (values < 0).any():
+        if name in JOHNSON_COOK_INPUTS and (values < 0).any():
             row = design.loc[values < 0, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
     design["run"] = design["run"].astype(np.int64)
-    check_design_box(design, config, columns, path)
+    check_design_box(design, box, columns, path)
     return design.reset_index(drop=True)
 
 
-def check_design_box(design: pd.DataFrame, config: dict, columns: list[str], source) -> None:
-    """Stop at the first run with an input outside the prior box (config `inputs`), saying which unit
-    the value would fit (e.g. V1 = 204: m/s, not cm/us); with `checks.design_box: false`, warn instead."""
-    velocities = {spec["velocity_input"]: shot for shot, spec in config["shots"].items()}
+def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], source) -> None:
+    """Stop at the first run with an input outside the prior box, saying which unit the value would
+    fit (e.g. V1 = 204: m/s, not cm/us); with `box.strict` false, warn instead."""
     for name in columns:
-        box = config["inputs"][name]
+        low, high = box.bounds[name]
         values = design[name].to_numpy(dtype=float)
-        slack = 1e-9 * (box["max"] - box["min"])  # float noise of a table written at a bound
-        outside = (values < box["min"] - slack) | (values > box["max"] + slack)
+        slack = 1e-9 * (high - low)  # float noise of a table written at a bound
+        outside = (values < low - slack) | (values > high + slack)
         if not outside.any():
             continue
         first = int(np.argmax(outside))
-        what = f"impact velocity {name} of shot {velocities[name]}" if name in velocities else f"parameter {name}"
-        problem = range_problem(what, values[first], box["unit"], (box["min"], box["max"]), f"the prior box inputs.{name}")
+        what = (f"impact velocity {name} of shot {box.velocity_of[name]}" if name in box.velocity_of
+                else f"parameter {name}")
+        problem = range_problem(what, values[first], box.units[name], (low, high), f"the prior box inputs.{name}")
         message = f"{source}: run {design['run'].iloc[first]}: {problem}; {int(outside.sum())} of {len(values)} runs are outside on {name}"
-        if config["checks"]["design_box"]:
+        if box.strict:
             raise InputError(f"{message}. If these points are intended, set checks.design_box: false")
         log.warning("%s (accepted: checks.design_box: false)", message)
-
-
-@dataclass(frozen=True)
-class ShotParameters:
-    """The inputs of one hydrocode run of one shot, in the paper's units (Mbar, cm/us)."""
-
-    A: float
-    B: float
-    C: float
-    n: float
-    m: float
-    velocity_cm_us: float
-    shear_modulus_Mbar: float
 
 
 @dataclass(frozen=True)
@@ -115,21 +132,16 @@ class ShotMapping:
     velocity_input: str
     shear_modulus_inputs: tuple[str, ...]
 
-    @classmethod
-    def from_config(cls, config: dict, shot: str) -> ShotMapping:
-        """From a validated config's `shots.<shot>` section (a ConfigError names an unknown shot)."""
-        spec = shot_config(config, shot)
-        return cls(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
-
     def inputs(self) -> list[str]:
         """The design columns the shot depends on: A, B, C, n, m, its velocity, its shear-modulus terms."""
-        return [*STRENGTH_INPUTS, self.velocity_input, *self.shear_modulus_inputs]
+        return [*JOHNSON_COOK_INPUTS, self.velocity_input, *self.shear_modulus_inputs]
 
     def parameters(self, row) -> ShotParameters:
-        """One design row (a mapping of input name to value) as this shot's hydrocode inputs."""
-        return ShotParameters(*(float(row[k]) for k in STRENGTH_INPUTS),
-                              velocity_cm_us=float(row[self.velocity_input]),
-                              shear_modulus_Mbar=float(sum(row[k] for k in self.shear_modulus_inputs)))
+        """One design row (a mapping of input name to value, Table IV units) as this shot's hydrocode
+        inputs; the values reach the kernel unconverted (`ShotParameters.from_table_iv`)."""
+        return ShotParameters.from_table_iv(*(float(row[k]) for k in JOHNSON_COOK_INPUTS),
+                                            velocity_cm_us=float(row[self.velocity_input]),
+                                            shear_modulus_Mbar=float(sum(row[k] for k in self.shear_modulus_inputs)))
 
     def check_positive(self, design: pd.DataFrame, source: str | Path) -> None:
         """Reject rows whose velocity or shear modulus is not positive for this shot, before any run starts."""
@@ -143,28 +155,15 @@ class ShotMapping:
                 raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {self.shot}")
 
 
-def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
-                 lhs: bool = False) -> tuple[pd.DataFrame, str]:
-    """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
-    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box, seeded from
-    `stream` of study.seed (`shockcal.seeds`) unless `seed` is given."""
-    if not lhs and config["design"]["file"]:
-        design = load_design(config["design"]["file"], config)
-        return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
-    seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
-    return latin_hypercube(prior_bounds(config), n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
-
-
-def write_design(design: pd.DataFrame, source: str, config: dict, path: str | Path) -> bool:
-    """Write a design table (run + the config's inputs, with their units and `source` in the
-    metadata) unless `path` already holds the same rows and columns; True when it wrote. Same rows
-    from another source (a hypercube saved as a design file) leave the file, its mtime and what
-    depends on it alone; its metadata keeps the first source."""
+def write_design(design: pd.DataFrame, source: str, box: InputBox, path: str | Path) -> bool:
+    """Write a design table (run + the box's inputs, with their units and `source` in the metadata)
+    unless `path` already holds the same rows and columns; True when it wrote. Same rows from another
+    source (a hypercube saved as a design file) leave the file, its mtime and what depends on it
+    alone; its metadata keeps the first source."""
     from shockcal.io import write_table
 
-    table = design[["run", *input_names(config)]].reset_index(drop=True)
-    meta = {"table": "design", "source": source,
-            "units": {name: config["inputs"][name]["unit"] for name in input_names(config)}}
+    table = design[["run", *box.names()]].reset_index(drop=True)
+    meta = {"table": "design", "source": source, "units": {name: box.units[name] for name in box.names()}}
     path = Path(path)
     if path.is_file() and pd.read_parquet(path).equals(table):
         return False

@@ -1,17 +1,12 @@
-"""Principal-component Gaussian-process emulator of the calibration features (SPEC section 5).
+"""The study's emulator of the calibration features: design columns mapped onto PC-GP emulators.
 
-`PCGPEmulator` works on plain arrays (inputs X in a box, outputs Y): outputs are standardized per
-column, projected on an orthogonal basis from the SVD of the standardized training outputs, and each
-basis weight gets its own GP (`shockcal.gp`) over inputs scaled to [0, 1]. Prediction returns the mean
-and covariance of the outputs, adding the covariance of what the truncated basis leaves out, with each
-output's sd scaled by a factor calibrated by K-fold. Cross-validation: closed-form LOO (diagnostic),
-K-fold and the outer check (everything refitted).
-
-The study's `Emulator` (`fit_emulator` on an `EmulatorSpec`) maps design columns to emulator
-inputs, in one of two structures (config `emulator.structure`):
+`fit_emulator(design, features, spec)` joins each shot's features (`shockcal.features`) to the design
+on `run` and fits one array-level `PCGPEmulator` (`shockcal.pcgp`) per block, in one of two
+structures (`EmulatorSpec.structure`, config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
+An `InputMap` says how a block's inputs derive from design columns (sums, and the powers eps^n and T*^m).
 
 Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units,
 settings, hyperparameters); loading rebuilds the Cholesky factors, so files stay small and no live
@@ -23,31 +18,21 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict, dataclass, field, replace
-from functools import cache
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from scipy.special import expit
-from threadpoolctl import ThreadpoolController, threadpool_limits
 
-from shockcal.config import STRENGTH_INPUTS, prior_bounds
 from shockcal.design import ShotMapping
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
-from shockcal.gp import GaussianProcess, Hyper
+from shockcal.features import CALIBRATION_FEATURES
+from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.io import atomic_path
+from shockcal.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
 from shockcal.seeds import stream_seed
 
-FORMAT_VERSION = 4                  # 4: the error model (3 had no error tails, 2 the strain^n input only)
-CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
-Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
-SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
-SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
-PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
 log = logging.getLogger("shockcal.emulator")
@@ -92,8 +77,8 @@ class InputMap:
 def shot_input_map(shot: ShotMapping, bounds: Mapping[str, tuple[float, float]], powers=()) -> InputMap:
     """A per-shot emulator's inputs: A, B, C, n, m, the shot's velocity, its summed shear modulus,
     then the `powers` (base, design column); `bounds`: the prior box by design input."""
-    terms = [[k] for k in STRENGTH_INPUTS] + [[shot.velocity_input], list(shot.shear_modulus_inputs)]
-    names = [*STRENGTH_INPUTS, shot.velocity_input, f"G_{shot.shot}"]
+    terms = [[k] for k in JOHNSON_COOK_INPUTS] + [[shot.velocity_input], list(shot.shear_modulus_inputs)]
+    names = [*JOHNSON_COOK_INPUTS, shot.velocity_input, f"G_{shot.shot}"]
     return _box_map(bounds, names, terms, powers)
 
 
@@ -112,30 +97,6 @@ def _box_map(bounds, names, terms, powers) -> InputMap:
     return InputMap(names, terms, np.array(lower), np.array(upper), list(powers))
 
 
-@dataclass
-class Settings:
-    """How a PCGPEmulator is fitted (config `emulator`, or keyword arguments from a notebook)."""
-
-    family: str = "matern52"       # correlation family (correlation.FAMILIES)
-    fit_mean: bool = True          # per-component constant mean (GLS), else zero
-    n_components: float = 0.999    # integer count, or variance fraction in (0, 1)
-    n_starts: int = 2              # L-BFGS-B starts per GP
-    max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
-    seed: int = 0
-    n_jobs: int = 1                # processes for the GP fits, threads for prediction (one BLAS thread each)
-    cv_folds: int = 10             # K-fold of the sd calibration
-    calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
-    cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
-    switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
-    error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
-
-    @classmethod
-    def from_config(cls, settings: dict, seed: int) -> Settings:
-        keys = ("family", "fit_mean", "n_components", "n_starts", "max_fit_runs", "n_jobs", "cv_folds", "calibrate_sd",
-                "cv_warm_start", "switch_ratio", "error_tails")
-        return cls(seed=seed, **{k: settings[k] for k in keys if k in settings})
-
-
 @dataclass(frozen=True)
 class EmulatorSpec:
     """What the study's emulator is fitted over: its structure (`per_shot` or `joint`), how each shot
@@ -147,341 +108,6 @@ class EmulatorSpec:
     bounds: Mapping[str, tuple[float, float]]
     powers: tuple[tuple[float, str], ...] = ()
     settings: Settings = field(default_factory=Settings)
-
-    @classmethod
-    def from_config(cls, config: dict, shots) -> EmulatorSpec:
-        """The adapter from a validated config (`emulator`, `inputs`, `shots`, study.seed) for `shots`."""
-        section = config["emulator"]
-        powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key])
-        return cls(section["structure"], {s: ShotMapping.from_config(config, s) for s in shots}, prior_bounds(config),
-                   powers, Settings.from_config(section, config["study"]["seed"]))
-
-
-@dataclass
-class Switch:
-    """A regime switch of the outputs: past mean[numerator] / mean[denominator] = switch_ratio
-    (columns of Y; e.g. v_elastic / v_plastic near 1, a single-wave trace), the `affected` columns
-    get sd factors of their own, since the emulator's error there differs from the bulk's."""
-
-    numerator: int
-    denominator: int
-    affected: list[int]
-
-
-@dataclass
-class HeldOut:
-    """Held-out predictions of a cross-validation scheme: row indices, mean and sd (N, F), and the
-    covariance (N, F, F) where the scheme has it (not closed-form LOO)."""
-
-    scheme: str
-    rows: np.ndarray
-    mean: np.ndarray
-    sd: np.ndarray
-    cov: np.ndarray | None = None
-
-    def scaled(self, factors: np.ndarray) -> HeldOut:
-        """The same predictions with sd (and covariance) scaled by per-row, per-feature factors (N, F)."""
-        cov = None if self.cov is None else self.cov * factors[:, :, None] * factors[:, None, :]
-        return HeldOut(self.scheme, self.rows, self.mean, self.sd * factors, cov)
-
-    def distances(self, y: np.ndarray) -> tuple[np.ndarray, int]:
-        """Squared Mahalanobis distance of each held-out error (y[rows] - mean) under its covariance,
-        in the space the covariance spans (a pseudo-inverse: duplicated outputs make it singular),
-        and that space's dimension (the covariances' median rank)."""
-        err = y[self.rows] - self.mean
-        rank = int(np.median(np.linalg.matrix_rank(self.cov, hermitian=True)))
-        return np.einsum("ni,nij,nj->n", err, np.linalg.pinv(self.cov, hermitian=True), err), rank
-
-
-def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
-    """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
-    with threadpool_limits(1):
-        return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
-                                   family=settings.family, fit_mean=settings.fit_mean, start=start).hyper
-
-
-@cache
-def _blas_threads() -> ThreadpoolController:
-    """The process's thread pools, inspected once (a fresh inspection costs ~2.5 ms per prediction)."""
-    return ThreadpoolController()
-
-
-class PCGPEmulator:
-    """Principal-component GP emulator on plain arrays: inputs X (N, d) in a box, outputs Y (N, F).
-
-    >>> emu = PCGPEmulator.fit(X, Y, lower, upper, Settings(family="matern52"))
-    >>> mean, cov = emu.predict(X_new)            # (M, F), (M, F, F)
-    >>> cv = emu.cross_validate(10)               # refits everything per fold
-    """
-
-    def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings, sd_factor=None, switches=None, error: ErrorModel | None = None):
-        self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-        self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
-        self.residual_cov = np.asarray(residual_cov)
-        self.x_train, self.y_train = np.asarray(x_train, dtype=float), np.asarray(y_train, dtype=float)
-        self.settings = settings
-        # sd factors (2, F): row 0 in the usual regime, row 1 past a switch (see `switch_weight`)
-        self.sd_factor = np.ones((2, len(self.mean))) if sd_factor is None else np.asarray(sd_factor, dtype=float)
-        self.switches: list[Switch] = list(switches or [])
-        self.kfold: HeldOut | None = None          # the K-fold of the sd calibration, kept for reporting
-        self.error = error or ErrorModel()         # the error's distribution around (mean, covariance)
-        self.weights = self.project((self.y_train - self.mean) / self.scale)
-        self.gps = [GaussianProcess(self.x_train, self.weights[:, j], h, family=settings.family)
-                    for j, h in enumerate(hypers)]
-
-    def project(self, z: np.ndarray) -> np.ndarray:
-        """Basis weights of standardized outputs z (least squares on the orthogonal basis)."""
-        return z @ self.basis.T / np.sum(self.basis**2, axis=1)
-
-    def scaled(self, X) -> np.ndarray:
-        return (np.asarray(X, dtype=float) - self.lower) / (self.upper - self.lower)
-
-    @classmethod
-    def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None,
-            switches: list[Switch] | None = None) -> PCGPEmulator:
-        """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode (from
-        `starts`, one per component, if given; else from `settings.n_starts` starts).
-
-        With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
-        quantile of its K-fold |error| / sd over 1.645: one factor per feature, never per run, and
-        a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
-        traces), when there are at least SWITCH_MIN_RUNS of them.
-
-        With `settings.error_tails == "student_t"`, the error model's (dof, scale) are fitted to
-        the Mahalanobis distances of the same K-fold's errors (`shockcal.error_model`).
-        """
-        settings = settings or Settings()
-        model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
-        model.switches = list(switches or [])
-        if settings.calibrate_sd or settings.error_tails == "student_t":
-            held, folds = model._kfold(settings.cv_folds, settings.seed)
-            if settings.calibrate_sd:
-                model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
-                held = _cross_fitted(model, held, folds)
-            model.kfold = held
-            if settings.error_tails == "student_t":
-                model.error = ErrorModel.fit(*held.distances(model.y_train))
-                log.info("error model: Student t, dof %.2f, scale %.3f (from %d K-fold errors)",
-                         model.error.dof, model.error.scale, len(held.rows))
-        return model
-
-    @classmethod
-    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets, starts=None) -> list[PCGPEmulator]:
-        """One emulator per set of training rows, all GP fits in one (parallel) batch. `starts`:
-        hyperparameters to start component j's fit from (a refit of the same data's subsets)."""
-        X, Y = np.asarray(X, dtype=float), np.asarray(Y, dtype=float)
-        x_all = (X - np.asarray(lower, dtype=float)) / (np.asarray(upper, dtype=float) - np.asarray(lower, dtype=float))
-        parts, tasks = [], []
-        for rows in row_sets:
-            x, y = x_all[rows], Y[rows]
-            mean, scale = y.mean(0), y.std(0)
-            scale = np.where(scale > 0, scale, 1.0)
-            z = (y - mean) / scale
-            u, s, vt = np.linalg.svd(z, full_matrices=False)
-            p = _component_count(s, settings.n_components)
-            n = len(y)
-            weights = u[:, :p] * np.sqrt(n)                   # unit-variance weights
-            basis = vt[:p] * (s[:p, None] / np.sqrt(n))       # z ~ weights @ basis
-            residual = z - weights @ basis
-            # children of the seed: the fit subset, then one per component's GP starts (the root draws the folds)
-            subset_seed, *component_seeds = np.random.SeedSequence(settings.seed).spawn(1 + p)
-            fit_rows = (None if n <= settings.max_fit_runs else
-                        np.sort(np.random.default_rng(subset_seed).choice(n, settings.max_fit_runs, replace=False)))
-            parts.append((x, y, mean, scale, basis, residual.T @ residual / n))
-            tasks += [(x, weights[:, j], fit_rows, settings, component_seeds[j],
-                       starts[j] if starts is not None and j < len(starts) else None) for j in range(p)]
-        if settings.n_jobs > 1:
-            hypers = Parallel(n_jobs=settings.n_jobs)(delayed(_fit_hyper)(*t) for t in tasks)
-        else:
-            hypers = [_fit_hyper(*t) for t in tasks]
-        out, start = [], 0
-        for x, y, mean, scale, basis, residual_cov in parts:
-            p = len(basis)
-            out.append(cls(lower, upper, mean, scale, basis, residual_cov, x, y, hypers[start:start + p],
-                           settings))
-            start += p
-        return out
-
-    def predict(self, X) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (N, F) and covariance (N, F, F) at inputs X (N, d) in the box's units."""
-        return self.predict_scaled(self.scaled(X))
-
-    def predict_scaled(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (N, F) and covariance (N, F, F) at inputs x scaled to [0, 1]."""
-        w_mean, w_var = self._predict_weights(np.ascontiguousarray(x, dtype=float))
-        z_cov = np.einsum("nj,jf,jg->nfg", w_var, self.basis, self.basis) + self.residual_cov
-        mean = self.mean + (w_mean @ self.basis) * self.scale
-        sd_scale = self.scale * self.sd_factors(mean)                              # (N, F)
-        return mean, z_cov * sd_scale[:, :, None] * sd_scale[:, None, :]
-
-    def error_groups(self) -> list[tuple[np.ndarray, ErrorModel]]:
-        """All outputs in one group with this emulator's error model (a calibration `Problem`'s
-        `error_groups` from a notebook)."""
-        return [(np.arange(len(self.mean)), self.error)]
-
-    def switch_weight(self, mean: np.ndarray) -> np.ndarray:
-        """(N, F) weight of the switched regime at predicted means: for each switch's columns a
-        logistic step in mean[numerator] / mean[denominator] at `settings.switch_ratio` (width
-        SWITCH_WIDTH), smooth so that the calibration likelihood stays smooth; 0 elsewhere."""
-        weight = np.zeros_like(mean)
-        if self.settings.switch_ratio:
-            for sw in self.switches:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    ratio = mean[:, sw.numerator] / mean[:, sw.denominator]
-                step = expit((np.nan_to_num(ratio, nan=0.0) - self.settings.switch_ratio) / SWITCH_WIDTH)
-                weight[:, sw.affected] = step[:, None]
-        return weight
-
-    def sd_factors(self, mean: np.ndarray) -> np.ndarray:
-        """(N, F) sd factors at predicted means, blending the usual and the switched regime's."""
-        return _blend(self.sd_factor, self.switch_weight(mean))
-
-    def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Mean and variance (N, p) of each basis weight at scaled inputs x, on `settings.n_jobs`
-        threads: the components' cross-covariances on Python threads (numba's kernel releases the
-        GIL), then their triangular solves on BLAS threads (scipy's LAPACK wrappers hold the GIL).
-        In batches of PREDICT_BATCH points, which bounds the memory of the cross-covariances."""
-        threads = self.settings.n_jobs
-        means, variances = [], []
-        for start in range(0, len(x), PREDICT_BATCH):
-            batch = x[start:start + PREDICT_BATCH]
-            with ThreadPoolExecutor(threads) as pool:
-                cross = list(pool.map(lambda gp: gp.prior_cov(batch, gp.x), self.gps))  # noqa: B023 (used at once)
-            with _blas_threads().limit(limits=threads, user_api="blas"):
-                parts = [gp.predict_from_cross_cov(k) for gp, k in zip(self.gps, cross)]
-            means.append(np.column_stack([m for m, _ in parts]))
-            variances.append(np.column_stack([v for _, v in parts]))
-        return np.concatenate(means), np.concatenate(variances)
-
-    def loo(self) -> HeldOut:
-        """Closed-form leave-one-out (hyperparameters and basis fixed): a fast diagnostic that flatters."""
-        w_mean = np.empty_like(self.weights)
-        w_var = np.empty_like(self.weights)
-        for j, gp in enumerate(self.gps):
-            w_mean[:, j], w_var[:, j] = gp.loo()
-        z_var = w_var @ self.basis**2 + np.diag(self.residual_cov)
-        mean = self.mean + (w_mean @ self.basis) * self.scale
-        return HeldOut("loo_closed_form", np.arange(len(self.y_train)),
-                       mean, np.sqrt(z_var) * self.scale * self.sd_factors(mean))
-
-    def cross_validate(self, k: int = 10, seed: int | None = None) -> HeldOut:
-        """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold.
-
-        With `calibrate_sd`, each fold's sd is scaled by factors estimated from the other folds.
-        """
-        seed = self.settings.seed if seed is None else seed
-        if self.kfold is not None and (k, seed) == (self.settings.cv_folds, self.settings.seed):
-            return self.kfold
-        held, folds = self._kfold(k, seed)
-        return _cross_fitted(self, held, folds) if self.settings.calibrate_sd else held
-
-    def _kfold(self, k: int, seed: int) -> tuple[HeldOut, list[np.ndarray]]:
-        """K-fold held-out predictions with the fold models' own sd, and the folds."""
-        n = len(self.y_train)
-        order = np.random.default_rng(seed).permutation(n)
-        folds = [np.sort(f) for f in np.array_split(order, min(k, n))]
-        trains = [np.setdiff1d(np.arange(n), f) for f in folds]
-        return self._held_out("kfold", folds, trains), folds
-
-    def outer_check(self, margin: float = 0.05, columns=None) -> HeldOut:
-        """Train on runs with every scaled input (of `columns`, default all) in [margin, 1 - margin];
-        predict the others (near the faces)."""
-        x = self.x_train if columns is None else self.x_train[:, columns]
-        inner = np.all((x >= margin) & (x <= 1 - margin), axis=1)
-        if inner.sum() < self.x_train.shape[1] + 2:
-            log.warning("outer check skipped: %d runs inside the inner box, %d needed", inner.sum(),
-                        self.x_train.shape[1] + 2)
-            empty = np.empty((0, self.y_train.shape[1]))
-            return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
-        held = self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
-        return held.scaled(self.sd_factors(held.mean))
-
-    def _held_out(self, scheme, tests, trains) -> HeldOut:
-        starts = [gp.hyper for gp in self.gps] if self.settings.cv_warm_start else None
-        models = self._fit_many(self.x_train, self.y_train, np.zeros(len(self.lower)), np.ones(len(self.upper)),
-                                self.settings, trains, starts)
-        rows = np.concatenate(tests)
-        f = self.y_train.shape[1]
-        mean, cov = np.empty((len(rows), f)), np.empty((len(rows), f, f))
-        start = 0
-        for model, test in zip(models, tests):
-            mean[start:start + len(test)], cov[start:start + len(test)] = model.predict_scaled(self.x_train[test])
-            start += len(test)
-        return HeldOut(scheme, rows, mean, np.sqrt(np.einsum("nff->nf", cov)), cov)
-
-    def to_arrays(self, prefix: str = "") -> dict:
-        arrays = {"lower": self.lower, "upper": self.upper, "mean": self.mean, "scale": self.scale,
-                  "basis": self.basis, "residual_cov": self.residual_cov, "x_train": self.x_train,
-                  "y_train": self.y_train, "sd_factor": self.sd_factor}
-        return {f"{prefix}{k}": v for k, v in arrays.items()}
-
-    def to_json(self) -> dict:
-        return {"settings": asdict(self.settings), "switches": [asdict(sw) for sw in self.switches],
-                "error": self.error.to_json(),
-                "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
-                                     "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
-
-    @classmethod
-    def from_saved(cls, meta: dict, arrays, prefix: str = "") -> PCGPEmulator:
-        hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
-        fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
-        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
-                   arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]],
-                   ErrorModel.from_json(meta["error"]))
-
-    def save(self, path) -> Path:
-        """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
-        path = Path(path)
-        header = {"format": "shockcal-pcgp", "version": FORMAT_VERSION, **self.to_json()}
-        with atomic_path(path) as tmp:
-            np.savez(tmp, header=np.array(json.dumps(header)), **self.to_arrays())
-        return path
-
-    @classmethod
-    def load(cls, path) -> PCGPEmulator:
-        with np.load(path) as npz:
-            arrays = dict(npz)
-        header = json.loads(str(arrays.pop("header")))
-        if header.get("format") != "shockcal-pcgp" or header.get("version") != FORMAT_VERSION:
-            raise InputError(f"{path}: not a shockcal PC-GP emulator of version {FORMAT_VERSION}")
-        return cls.from_saved(header, arrays)
-
-
-def _sd_factor(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> np.ndarray:
-    """(2, F) sd factors from the rows `use` of a held-out set: per feature, the 90% quantile of
-    |error| / sd over 1.645, in the usual regime (row 0) and past a switch (row 1; the usual one
-    where fewer than SWITCH_MIN_RUNS held-out values are past it)."""
-    z = np.abs(held.mean[use] - model.y_train[held.rows[use]]) / held.sd[use]
-    switched = model.switch_weight(held.mean[use]) > 0.5
-    factors = np.tile(np.quantile(z, 0.9, axis=0) / Z90, (2, 1))
-    for col in np.flatnonzero(switched.sum(0) >= SWITCH_MIN_RUNS):
-        past = switched[:, col]
-        factors[:, col] = np.quantile(z[~past, col], 0.9) / Z90, np.quantile(z[past, col], 0.9) / Z90
-    return factors
-
-
-def _blend(factors: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    """(N, F) factors: the usual regime's, moved towards the switched one's by weight (N, F)."""
-    return factors[0] + weight * (factors[1] - factors[0])
-
-
-def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
-    """K-fold sd scaled, fold by fold, by the factors of the other folds (an honest coverage)."""
-    fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
-    factors = np.empty_like(held.sd)
-    for j in range(len(folds)):
-        here = fold_of == j
-        factors[here] = _blend(_sd_factor(model, held, ~here), model.switch_weight(held.mean[here]))
-    return held.scaled(factors)
-
-
-def _component_count(singular_values: np.ndarray, n_components: float) -> int:
-    """An integer count, or the fewest components explaining a variance fraction in (0, 1)."""
-    if n_components >= 1:
-        return int(min(n_components, len(singular_values)))
-    explained = np.cumsum(singular_values**2) / np.sum(singular_values**2)
-    return int(np.searchsorted(explained, n_components) + 1)
 
 
 @dataclass
@@ -656,8 +282,15 @@ def _check_training_inputs(table: pd.DataFrame, input_map: InputMap, label: str)
 
 def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: EmulatorSpec,
                  sources: dict[str, str] | None = None) -> Emulator:
-    """Fit the study's emulator to a design (Table IV units) and per-shot feature tables (m/s, us),
-    joined on `run`; block i fits with stream ("emulator", i) of `spec.settings.seed`."""
+    """Fit the study's emulator; block i fits with stream ("emulator", i) of `spec.settings.seed`.
+
+    Args:
+        design: design table (`run` and the inputs, Table IV units).
+        features: shot -> its features table (`run`, `status`, the calibration features in m/s),
+            joined to the design on `run`; failed or NaN runs are dropped with a logged count.
+        spec: structure, shot mappings, prior box, power inputs and GP settings (`EmulatorSpec`).
+        sources: shot -> where its table came from, for messages.
+    """
     shots = list(features)
     unmapped = [shot for shot in shots if shot not in spec.shots]
     if unmapped:

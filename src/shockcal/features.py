@@ -42,7 +42,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import optimize, stats
 
-from shockcal.config import shot_config
 from shockcal.errors import InputError, ShockcalError
 
 if TYPE_CHECKING:
@@ -51,6 +50,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("shockcal.features")
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
+CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]   # what the emulator and calibration use
 ARRIVAL_FRACTION = 0.02
 QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0
@@ -123,23 +123,34 @@ def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class ExtractorSettings:
-    """How one shot's traces are read: the analysis window and the elastic cut-off after the arrival
-    (us; config `shots.<shot>.analysis`), the mixture's components and PIT samples (config `features`).
-    The defaults are the config schema's (a test keeps them equal)."""
+    """How one shot's traces are read; the defaults are the config schema's (a test keeps them equal).
+
+    Args:
+        window_after_arrival_us: end of the analysis window after the detected arrival (us; config
+            `shots.<shot>.analysis`); it must end before the release from the flyer's back arrives.
+        cutoff_after_arrival_us: the elastic cut-off after the arrival (us): components ending before
+            it form the early (elastic) mixture.
+        n_components: Gaussian mixture components (config `features`).
+        n_samples: stratified PIT samples of the trace's CDF (config `features`).
+    """
 
     window_after_arrival_us: float = 1.2
     cutoff_after_arrival_us: float = 0.04
     n_components: int = 5
     n_samples: int = 10000
 
-    @classmethod
-    def from_config(cls, config: dict, shot: str) -> ExtractorSettings:
-        """From a validated config's `shots.<shot>.analysis` and `features` sections."""
-        return cls(**shot_config(config, shot)["analysis"], **config["features"])
-
 
 def extract(t, v, settings: ExtractorSettings = ExtractorSettings()) -> Extraction:
-    """Run the extractor on one trace (t in us, v in m/s); raises FeatureError when it cannot."""
+    """Run the extractor on one trace; raises FeatureError when it cannot.
+
+    Args:
+        t: times (us), increasing.
+        v: free-surface velocity (m/s) at those times.
+        settings: the analysis window, elastic cut-off and mixture size (`ExtractorSettings`).
+
+    Returns:
+        An `Extraction`: the ten features (times us, velocities m/s) and the intermediate steps.
+    """
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
     bad = ~(np.isfinite(t) & np.isfinite(v))
     if bad.any():
@@ -275,22 +286,3 @@ def check_failures(table, max_fraction: float, shot: str) -> None:
         worst = "\n".join(f"  run {r.run}: {r.reason}" for r in failed.head(10).itertuples())
         raise ShockcalError(f"shot {shot}: {len(failed)} of {len(table)} runs failed, more than the allowed "
                             f"{max_fraction:.0%} (simulate.max_failed_fraction); the first:\n{worst}")
-
-
-def observed_table(config: dict):
-    """The measured features of every shot (one row per shot: shot, source, the ten features), from
-    the VISAR records through this extractor (`observed.source: records`) or the published values."""
-    import pandas as pd
-
-    observed = config["observed"]
-    rows = []
-    for shot in config["shots"]:      # load_config checked that every shot has its source's entry
-        if observed["source"] == "records":
-            spec = observed["records"][shot]
-            rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
-                         **record_features(spec["path"], ExtractorSettings.from_config(config, shot), shot,
-                                              spec["time_column"], spec["velocity_column"])})
-        else:
-            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
-                         **observed["features"][shot]})
-    return pd.DataFrame(rows)[["shot", "source", *COLUMNS]]

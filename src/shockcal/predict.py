@@ -12,20 +12,25 @@ import logging
 import numpy as np
 import pandas as pd
 
-from shockcal.config import input_names
 from shockcal.errors import InputError
 from shockcal.io import require_columns
 
 log = logging.getLogger(__name__)
 
-def draw_posterior_design(posterior: pd.DataFrame, config: dict, n: int, seed: int,
+def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, seed: int,
                           source: str = "posterior") -> pd.DataFrame:
     """`n` rows drawn (seeded, without replacement when possible) from the posterior samples.
 
-    Returns a design table: `run` 0..n-1 and every config input. The posterior must hold every input
-    (a joint posterior); an empty table or a missing input is an InputError naming `source`.
+    Args:
+        posterior: equal-weight posterior draws (one column per input, native units).
+        names: the design's inputs, in order (every input of the study: a joint posterior).
+        n: rows to draw.
+        seed: the draw's seed.
+        source: names `posterior` in errors.
+
+    Returns a design table: `run` 0..n-1 and the inputs `names`. An empty table or a missing input is
+    an InputError naming `source`.
     """
-    names = input_names(config)
     if posterior.empty:
         raise InputError(f"{source}: posterior has no samples; cannot draw {n} posterior runs")
     require_columns(posterior, names, source)
@@ -57,12 +62,3 @@ def emulator_predictions(emulator, design: pd.DataFrame, shots: list[str]) -> pd
         part.insert(0, "run", design["run"].to_numpy())
         parts.append(part)
     return pd.concat(parts, ignore_index=True)
-
-
-def emulator_predictions_long(emulator, design: pd.DataFrame, shots: list[str]) -> pd.DataFrame:
-    """`emulator_predictions` with one row per (run, shot, feature): run, shot, feature, mean, sd (m/s)."""
-    wide = emulator_predictions(emulator, design, shots)
-    names = list(emulator.feature_names)
-    table = wide.melt(id_vars=["run", "shot"], value_vars=names, var_name="feature", value_name="mean")
-    table["sd"] = wide.melt(id_vars=["run", "shot"], value_vars=[f"{n}_sd" for n in names])["value"].to_numpy()
-    return table.sort_values("run", kind="stable").reset_index(drop=True)

@@ -13,17 +13,21 @@ arm (reference 67%) depending on its settings, and our earlier hand-built ensemb
 none.
 
 The draws are weighted; `WeightedDraws.resample` gives equal-weight rows for consumers that want
-them (figures, posterior-predictive runs), and summaries use the weights.
+them (figures, posterior-predictive runs), and summaries use the weights. `sample(problem, settings)`
+returns a `Posterior`, which keeps both, the evidence and the sampler's counts.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
+from shockcal.summaries import summarize
 
 
 @dataclass
@@ -95,3 +99,112 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     cube, log_w, log_l = (np.asarray(a) for a in sampler.posterior())
     return WeightedDraws(to_parameters(cube), log_w - logsumexp(log_w), log_l - log_density_ratio(cube),
                          float(sampler.log_z), int(sampler.n_like))
+
+
+@dataclass(frozen=True)
+class SamplerSettings:
+    """How nautilus samples a posterior.
+
+    Args:
+        n_live: live points.
+        n_eff: the effective sample size (Kish) of the weighted draws at which the run stops.
+        draws: equal-weight draws resampled from the weighted ones (`Posterior.draws`).
+        seed: the sampler's and the resampling's seed.
+        cube_power: unit-cube power of named inputs (`nested_sample`'s `cube_power`: where the sampler
+            looks, not the posterior).
+        max_evaluations: likelihood evaluations after which a run short of `n_eff` stops with an error.
+    """
+
+    n_live: int = 1000
+    n_eff: int = 3000
+    draws: int = 10000
+    seed: int = 0
+    cube_power: Mapping[str, float] = field(default_factory=dict)
+    max_evaluations: int = 500_000
+
+
+@dataclass
+class Posterior:
+    """A sampled posterior: the sampler's weighted draws (the exact result), an equal-weight resample,
+    the log evidence with its uncertainty and the sampler's counts.
+
+    `names` are the parameters: the calibrated inputs (native units), then lambda_y. `draws` has one
+    row per equal-weight draw (the parameters and `log_likelihood`); `weighted_table()` the weighted
+    draws with their log weights; `summary()` the weighted mean, sd and quantiles with their Monte
+    Carlo errors; `info()` everything else (evidence, counts, settings) as a plain dict.
+    """
+
+    names: list[str]
+    weighted: WeightedDraws
+    draws: pd.DataFrame
+    settings: SamplerSettings
+    cube_power: dict
+    distinct_draws: int
+    units: dict = field(default_factory=dict)
+    context: dict = field(default_factory=dict)    # what the caller adds to info() (shots, measured features)
+
+    @property
+    def log_evidence(self) -> float:
+        """log Z, the likelihood's normalising constants included."""
+        return self.weighted.log_evidence
+
+    @property
+    def log_evidence_sd(self) -> float:
+        """The importance-sampling estimate of log Z's Monte Carlo sd: sqrt(1 / ESS - 1 / N) by the delta
+        method (ESS the Kish ESS of the weights, N the draws). nautilus's draws are not independent, so
+        this is a lower bound; repeat seeds for an honest spread."""
+        n = len(self.weighted.log_weight)
+        return float(np.sqrt(max(1.0 / self.weighted.kish_ess() - 1.0 / n, 0.0)))
+
+    def summary(self) -> pd.DataFrame:
+        """Per parameter: weighted mean, sd, 5/50/95% quantiles with their Monte Carlo standard errors,
+        the Kish ESS, and the unit where known."""
+        table = summarize(self.weighted, self.names)
+        if self.units:
+            table.insert(1, "unit", table["parameter"].map(self.units))
+        return table
+
+    def weighted_table(self) -> pd.DataFrame:
+        """The weighted draws: the parameters, `log_weight` (normalised: logsumexp = 0) and `log_likelihood`."""
+        table = pd.DataFrame(self.weighted.points, columns=self.names)
+        table["log_weight"] = self.weighted.log_weight
+        table["log_likelihood"] = self.weighted.log_likelihood
+        return table
+
+    def info(self) -> dict:
+        """The run: sampler settings, log evidence and its sd, likelihood evaluations, Kish ESS, draws."""
+        return {"sampler": "nautilus", "n_live": self.settings.n_live, "n_eff_target": self.settings.n_eff,
+                "seed": self.settings.seed, "log_evidence": self.log_evidence,
+                "log_evidence_sd": self.log_evidence_sd, "likelihood_evaluations": self.weighted.n_likelihood,
+                "cube_power": self.cube_power, "weighted_draws": len(self.weighted.points),
+                "ess_kish": self.weighted.kish_ess(), "retained": len(self.draws),
+                "distinct_draws": self.distinct_draws, **self.context}
+
+    def __repr__(self) -> str:
+        return (f"Posterior({len(self.names)} parameters {self.names}, {len(self.weighted.points)} weighted draws, "
+                f"Kish ESS {self.weighted.kish_ess():.0f}, {len(self.draws)} equal-weight draws, "
+                f"log Z {self.log_evidence:.3f} +- {self.log_evidence_sd:.3f}, "
+                f"{self.weighted.n_likelihood} likelihood evaluations)")
+
+
+def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> Posterior:
+    """Sample a problem's posterior with nautilus.
+
+    Args:
+        problem: a `shockcal.problem.Problem` (prior transform, batch log-likelihood, names).
+        settings: the sampler's settings.
+        other_powers: `Problem.cube_power`'s `others` ("error": a power of an input the problem does
+            not calibrate is an error; "ignore": skipped).
+
+    Returns:
+        The `Posterior`: weighted draws, `settings.draws` equal-weight draws resampled from them, evidence.
+    """
+    power = problem.cube_power(settings.cube_power, other_powers)
+    weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
+                             settings.n_eff, settings.seed, power, settings.max_evaluations)
+    names = [*problem.names, "lambda_y"]
+    rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
+    draws = pd.DataFrame(weighted.points[rows], columns=names)
+    draws["log_likelihood"] = weighted.log_likelihood[rows]
+    return Posterior(names, weighted, draws, settings, {k: float(p) for k, p in zip(problem.names, power) if p != 1.0},
+                     int(len(np.unique(rows))))

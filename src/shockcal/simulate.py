@@ -14,7 +14,6 @@ import logging
 import numpy as np
 import pandas as pd
 
-from shockcal.config import end_time_us
 from shockcal.design import ShotMapping
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
@@ -27,25 +26,26 @@ UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_r
          "t_us": "us", "v_m_s": "m/s"}
 
 
-def hydro_inputs(config: dict, spec: dict, end_us: float | None = None):
-    """The adapter from a validated config to `run_shot`'s inputs for one shot (`spec`, its `shots`
-    section): (Geometry, MaterialProperties, HydroSettings); `end_us` defaults to the config's end time."""
-    end_us = end_time_us(config, spec) if end_us is None else end_us
-    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us)),
-            MaterialProperties.from_config(config["material"]), HydroSettings.from_config(config["hydro"]))
-
-
 def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geometry, material: MaterialProperties,
                     settings: HydroSettings) -> pd.DataFrame:
-    """Simulate every row of `design` (Table IV units) for the shot `mapping` reads it as, to
-    `geometry.end_us`; failures become rows with a reason. From a config: `ShotMapping.from_config` and `hydro_inputs`."""
+    """Simulate every row of `design` for one shot; failures become rows with a reason.
+
+    Args:
+        design: design table (`run` and the inputs `mapping` reads, Table IV units).
+        mapping: how the shot reads a design row (its velocity and shear-modulus inputs).
+        geometry: flyer and target thickness (mm) and the simulated time (us).
+        material: EOS and thermal constants (user units).
+        settings: the hydrocode's numerics.
+
+    From a study config: `shockcal.study.adapters.shot_mapping` and `hydro_inputs`.
+    """
     shot, inputs = mapping.shot, mapping.inputs()
     rows = []
     for record in design.to_dict("records"):
         params = mapping.parameters(record)
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
-               "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
-               "shear_modulus_GPa": params.shear_modulus_Mbar * MBAR_TO_GPA}
+               "impact_velocity_m_s": params.table_iv().velocity_cm_us * CM_US_TO_M_S,
+               "shear_modulus_GPa": params.table_iv().shear_modulus_Mbar * MBAR_TO_GPA}
         try:
             result = run_shot(params, geometry, material, settings)
         except Exception as exc:  # a run must never kill the batch; the reason is kept

@@ -9,3 +9,4 @@ J_PER_KG_TO_CODE = 1.0e-8          # 1 J/kg in (cm/us)^2
 PER_S_TO_PER_US = 1.0e-6
 CM_US_TO_M_S = 1.0e4
 MBAR_TO_GPA = 100.0
+MBAR_TO_MPA = 1.0e5

@@ -12,10 +12,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from shockcal.config import load_config, prior_bounds
-from shockcal.design import ShotMapping, latin_hypercube
-from shockcal.features import ExtractorSettings, features_table
-from shockcal.simulate import hydro_inputs, simulate_design
+from shockcal.design import latin_hypercube
+from shockcal.features import features_table
+from shockcal.simulate import simulate_design
+from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
+from shockcal.study.config import prior_bounds
+from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[2]
 OUT = Path(__file__).with_name("end_time_reference.csv")
@@ -39,8 +41,8 @@ def features_at(config: dict, end_time_us, runs=None) -> pd.DataFrame:
         design = design[design["run"].isin(runs)]
     tables = []
     for shot, spec in config["shots"].items():
-        traces = simulate_design(design, ShotMapping.from_config(config, shot), *hydro_inputs(config, spec))
-        tables.append(features_table(traces, ExtractorSettings.from_config(config, shot)).assign(shot=shot))
+        traces = simulate_design(design, shot_mapping(config, shot), *hydro_inputs(config, spec))
+        tables.append(features_table(traces, extractor_settings(config, shot)).assign(shot=shot))
     return pd.concat(tables, ignore_index=True)
 
 

@@ -10,6 +10,7 @@ rule calibrate:
     output:
         samples=f"{RESULTS}/posterior/{{name}}.parquet",
         summary=f"{RESULTS}/posterior/{{name}}_summary.parquet",
+        weighted=f"{RESULTS}/posterior/{{name}}_weighted.parquet",
     log:
         f"{LOGS}/calibrate/{{name}}.log",
     benchmark:

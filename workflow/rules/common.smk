@@ -4,8 +4,9 @@ import os
 
 import yaml
 
-from shockcal.design import ShotMapping, chunk_fingerprints, study_design, write_design
-from shockcal.stages import figure_config, stage_config
+from shockcal.design import chunk_fingerprints, write_design
+from shockcal.study.adapters import input_box, shot_mapping, study_design
+from shockcal.study.stages import figure_config, stage_config
 from shockcal.workflow import (
     chunk_count,
     chunk_rows,
@@ -17,7 +18,7 @@ from shockcal.workflow import (
 # its content so a dry run with other settings never rewrites the file running jobs read. Jobs get
 # it through $SHOCKCAL_CONFIG (the default of every `shockcal --config`); it is not a rule input or
 # param: reruns follow each rule's params slice, never this file's name or mtime. A rule's `settings`
-# param is `stage_config(config, STAGE)`: the keys shockcal.stages declares its stage reads, the same
+# param is `stage_config(config, STAGE)`: the keys shockcal.study.stages declares its stage reads, the same
 # slice the `shockcal` command hands the stage's code, so the two channels cannot drift apart.
 _EFFECTIVE_TEXT = yaml.safe_dump(config, sort_keys=True)
 EFFECTIVE_CONFIG = f"{RESULTS}/config/effective-{hashlib.sha256(_EFFECTIVE_TEXT.encode()).hexdigest()[:12]}.yaml"

@@ -16,11 +16,11 @@
 
 DESIGN = run_set_path("training", "design.parquet")
 _PLANNED_DESIGN, _DESIGN_SOURCE = study_design(config)
-write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, config, DESIGN)
+write_design(_PLANNED_DESIGN, _DESIGN_SOURCE, input_box(config), DESIGN)
 # a digest per shot and chunk, over the run ids and the columns that shot reads: a column added for
 # a new shot (its impact velocity) leaves every other shot's chunks alone
 CHUNK_DIGESTS = {
-    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *ShotMapping.from_config(config, shot).inputs()]], CHUNK_SIZE)
+    shot: chunk_fingerprints(_PLANNED_DESIGN[["run", *shot_mapping(config, shot).inputs()]], CHUNK_SIZE)
     for shot in SHOTS
 }
 RUN_SET_SIZES = {

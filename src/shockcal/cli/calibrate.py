@@ -1,4 +1,10 @@
-"""`shockcal calibrate` (posterior samples + summary) and `shockcal calibrate-check` (coverage on synthetic truth)."""
+"""`shockcal calibrate` (posterior: equal-weight and weighted draws, summary), `shockcal calibrate-check`
+(coverage on synthetic truth) and `shockcal coverage` (merging the check's batches).
+
+calibrate reads the emulator directory and the observed features table and writes OUT (equal-weight
+draws), OUT_summary.parquet and OUT_weighted.parquet (the sampler's weighted draws with their log
+weights: the exact result); config keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`,
+`inputs`, study.seed (shockcal.study.stages declares them)."""
 
 from __future__ import annotations
 
@@ -11,7 +17,8 @@ def register(subparsers) -> None:
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
     p.add_argument("--observed", required=True, help="observed features table (CSV or Parquet: shot + feature columns)")
-    p.add_argument("--out", required=True, help="posterior samples (Parquet); the summary goes beside it as *_summary.parquet")
+    p.add_argument("--out", required=True, help="posterior samples (Parquet); the summary and the weighted draws go "
+                                                 "beside it as *_summary.parquet and *_weighted.parquet")
     p.add_argument("--n-eff", type=int, help="override calibration.n_eff (effective sample size to reach)")
     p.set_defaults(func=run)
 
@@ -35,54 +42,62 @@ def register(subparsers) -> None:
     m.set_defaults(func=run_coverage)
 
 
-def summary_path(out):
+def summary_path(out, kind: str = "summary"):
+    """The table of `kind` ("summary", "weighted") beside the posterior samples `out`."""
     from pathlib import Path
 
     out = Path(out)
-    return out.with_name(out.stem + "_summary.parquet")
+    return out.with_name(f"{out.stem}_{kind}.parquet")
 
 
 def run(args) -> int:
     import logging
 
-    from shockcal.calibration import CalibrationSettings, calibrate
+    from shockcal.calibration import calibrate
     from shockcal.emulator import Emulator
     from shockcal.io import read_table, write_table
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import calibration_settings
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate")
     emulator = Emulator.load(args.emulator)
     observed = read_table(args.observed)
-    settings = CalibrationSettings.from_config(config, args.shots)
+    settings = calibration_settings(config, args.shots)
     if args.n_eff is not None:
         settings = settings.with_sampler(n_eff=args.n_eff)
-    samples, summary, info = calibrate(emulator, args.shots, observed, settings, source=args.observed)
+    posterior = calibrate(emulator, args.shots, observed, settings, source=args.observed)
+    info, summary = posterior.info(), posterior.summary()
     meta = {"table": "posterior samples", **info,
             "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
                        "log_likelihood (at the draw)"}
-    write_table(samples, args.out, meta)
+    write_table(posterior.draws, args.out, meta)
     write_table(summary, summary_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
+    write_table(posterior.weighted_table(), summary_path(args.out, "weighted"),
+                {**meta, "table": "posterior weighted draws",
+                 "columns": "nautilus's weighted draws (the exact result): inputs in `units`; lambda_y (-); log_weight "
+                            "(normalised, logsumexp = 0); log_likelihood"})
     logging.getLogger("shockcal.calibrate").info(
         "posterior of %s (Kish ESS %.0f, %d draws written, %d distinct, %d likelihood evaluations, "
-        "log evidence %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(samples), info["distinct_draws"],
-        info["likelihood_evaluations"],
-        info["log_evidence"], summary.to_string(index=False, float_format="%.4g"))
+        "log evidence %.3f +- %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(posterior.draws),
+        info["distinct_draws"], info["likelihood_evaluations"], info["log_evidence"], info["log_evidence_sd"],
+        summary.to_string(index=False, float_format="%.4g"))
     return 0
 
 
 def run_check(args) -> int:
-    from shockcal.calibration import CalibrationSettings, coverage_table, synthetic_truth
+    from shockcal.coverage import coverage_table, synthetic_truth
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
     from shockcal.seeds import stream_seed
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import calibration_settings
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate_check")
     truths = hydro_truths(args)
     truth = "emulator" if truths is None else "hydrocode"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
     table = synthetic_truth(Emulator.load(args.emulator), args.shots,
-                            CalibrationSettings.from_config(config, args.shots, check=True), trials,
+                            calibration_settings(config, args.shots, check=True), trials,
                             seed=stream_seed(config["study"]["seed"], "check", truth, *args.shots), truths=truths)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
@@ -91,7 +106,7 @@ def run_check(args) -> int:
 
 
 def run_coverage(args) -> int:
-    from shockcal.calibration import coverage_table
+    from shockcal.coverage import coverage_table
     from shockcal.io import read_tables, write_table
 
     table = read_tables(args.trials, ["trial", "parameter"], "per-trial")
@@ -104,7 +119,7 @@ def log_coverage(coverage, trials) -> None:
     """Log the per-parameter coverage and, when the trials carry it, the joint check (`joint_coverage`)."""
     import logging
 
-    from shockcal.calibration import joint_coverage, usable_trials
+    from shockcal.coverage import joint_coverage, usable_trials
 
     log = logging.getLogger("shockcal.calibrate")
     if "status" in trials:
@@ -133,7 +148,7 @@ def trial_range(text: str | None) -> range | None:
 
 def hydro_truths(args):
     """The hydrocode truth runs named on the command line, or None (emulator truth)."""
-    from shockcal.calibration import HydroTruths
+    from shockcal.coverage import HydroTruths
     from shockcal.errors import InputError
 
     if not args.truth_design and not args.truth_features:

@@ -22,8 +22,9 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.design import study_design, write_design
-    from shockcal.stages import load_stage_config
+    from shockcal.design import write_design
+    from shockcal.study.adapters import input_box, study_design
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, args.stream)  # the design or check_design stage
     if args.stream == "check_design":  # the check's truth runs: always a hypercube, of check.trials runs
@@ -31,6 +32,6 @@ def run(args) -> int:
     else:
         n_runs, lhs = args.n_runs, args.lhs
     design, source = study_design(config, n_runs, args.seed, args.stream, lhs)
-    write_design(design, source, config, args.out)
+    write_design(design, source, input_box(config), args.out)
     logging.getLogger("shockcal.design").info("wrote %d runs (%s) to %s", len(design), source, args.out)
     return 0

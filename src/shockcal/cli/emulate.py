@@ -1,5 +1,9 @@
-"""`shockcal emulate`, `emulate-cv`, `emulate-predict`: fit the PC-GP emulator and cross-validate it;
-its cross-validation table; its predictions on a design table."""
+"""`shockcal emulate` and `emulate-cv`: fit the PC-GP emulator and cross-validate it; its cross-validation
+table. (Its predictions at a design's rows: `shockcal predict-emulator`.)
+
+emulate reads the design and each shot's features table and writes the emulator directory
+(emulator.json, emulator.npz) with its cross-validation tables; config keys: `emulator`, `inputs`,
+`checks.design_box`, the shots' mappings, study.seed (shockcal.study.stages declares them)."""
 
 from __future__ import annotations
 
@@ -27,30 +31,23 @@ def register(subparsers) -> None:
     cv.add_argument("--margin", type=float, help="recompute the outer check with this inner-box margin")
     cv.set_defaults(func=print_cv)
 
-    pr = subparsers.add_parser("emulate-predict", help="emulator mean and sd of every feature at every design run")
-    add_config_argument(pr)
-    pr.add_argument("--emulator", required=True, help="emulator directory")
-    pr.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
-    pr.add_argument("--out", required=True, help="output Parquet: run, shot, feature, mean, sd (m/s)")
-    pr.set_defaults(func=predict)
-
 
 def run(args) -> int:
     import logging
     from dataclasses import replace
     from pathlib import Path
 
-    from shockcal.design import load_design
-    from shockcal.emulator import EmulatorSpec, fit_emulator
+    from shockcal.emulator import fit_emulator
     from shockcal.io import read_table
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import emulator_spec, load_study_design
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "emulate")
     paths = parse_pairs(args.features, "--features")
-    spec = EmulatorSpec.from_config(config, list(paths))
+    spec = emulator_spec(config, list(paths))
     if args.structure:
         spec = replace(spec, structure=args.structure)
-    design = load_design(args.design, config)
+    design = load_study_design(args.design, config)
     features = {shot: read_table(path) for shot, path in paths.items()}
     emulator = fit_emulator(design, features, spec, sources=paths)
     out = Path(args.out)
@@ -98,20 +95,4 @@ def print_cv(args) -> int:
         held = [read_table(out / "cv_heldout.parquet")] if (out / "cv_heldout.parquet").is_file() else []
         table = rmse_table(pd.concat([read_table(out / "cv.parquet"), *held], ignore_index=True))
     print(table.to_string(index=False))
-    return 0
-
-
-def predict(args) -> int:
-    from shockcal.design import load_design
-    from shockcal.emulator import Emulator
-    from shockcal.io import write_table
-    from shockcal.predict import emulator_predictions_long
-    from shockcal.stages import load_stage_config
-
-    config = load_stage_config(args.config, "emulate_predict")
-    emulator = Emulator.load(args.emulator)
-    design = load_design(args.design, config, columns=emulator.required_inputs(emulator.shots))
-    table = emulator_predictions_long(emulator, design, emulator.shots)
-    write_table(table, args.out, {"table": "emulator predictions", "design": args.design,
-                                  "emulator": args.emulator, "units": {"mean": "m/s", "sd": "m/s"}})
     return 0

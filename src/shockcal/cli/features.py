@@ -35,14 +35,15 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import pandas as pd
 
-    from shockcal.features import ExtractorSettings, check_failures, record_features
+    from shockcal.features import check_failures, record_features
     from shockcal.io import read_table, write_table
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import extractor_settings
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, feature_stages(args), args.shot)
     if args.record:
         table = pd.DataFrame([{"run": 0, "status": "ok", "reason": "",
-                               **record_features(args.record, ExtractorSettings.from_config(config, args.shot),
+                               **record_features(args.record, extractor_settings(config, args.shot),
                                                  args.shot, args.time_column, args.velocity_column)}])
     else:
         from shockcal.features import features_table
@@ -52,7 +53,7 @@ def run(args) -> int:
             table = read_tables(args.tables, ["run"], "features")
         else:
             traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
-            table = features_table(traces, ExtractorSettings.from_config(config, args.shot))
+            table = features_table(traces, extractor_settings(config, args.shot))
         if not args.no_failure_budget:
             check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
     write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,
@@ -61,16 +62,16 @@ def run(args) -> int:
 
 
 def feature_stages(args) -> list[str]:
-    """The stages (shockcal.stages) a `features` call is: extraction, the failed-run budget, or both."""
+    """The stages (shockcal.study.stages) a `features` call is: extraction, the failed-run budget, or both."""
     extracts = not args.tables
     budget = not args.record and not args.no_failure_budget
     return [stage for stage, used in (("features", extracts), ("failure_budget", budget)) if used]
 
 
 def run_observed(args) -> int:
-    from shockcal.features import observed_table
     from shockcal.io import write_table
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import observed_table
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "observed")
     table = observed_table(config)

@@ -33,11 +33,11 @@ def run(args) -> int:
     import logging
     from pathlib import Path
 
-    from shockcal.config import load_config
     from shockcal.errors import InputError
     from shockcal.plots.catalogue import FigureInputs, catalogue, figure_spec
     from shockcal.plots.style import save_figure
-    from shockcal.stages import figure_config
+    from shockcal.study.stages import figure_config
+    from shockcal.study.validate import load_config
 
     config = load_config(args.config)
     if args.list:

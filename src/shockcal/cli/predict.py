@@ -28,12 +28,13 @@ def run(args) -> int:
     from shockcal.io import read_table, write_table
     from shockcal.predict import draw_posterior_design
     from shockcal.seeds import stream_seed
-    from shockcal.stages import load_stage_config
+    from shockcal.study.config import input_names
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "predict")
     n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
     seed = stream_seed(config["study"]["seed"], "posterior_draws") if args.seed is None else args.seed
-    design = draw_posterior_design(read_table(args.posterior), config, n_runs, seed, source=args.posterior)
+    design = draw_posterior_design(read_table(args.posterior), input_names(config), n_runs, seed, source=args.posterior)
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})
@@ -44,16 +45,16 @@ def run(args) -> int:
 def run_emulator(args) -> int:
     import logging
 
-    from shockcal.design import load_design
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
     from shockcal.predict import emulator_predictions
-    from shockcal.stages import load_stage_config
+    from shockcal.study.adapters import load_study_design
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "emulate_predict")
     emulator = Emulator.load(args.emulator)
     shots = [s for s in config["shots"] if s in emulator.shots]
-    design = load_design(args.design, config)
+    design = load_study_design(args.design, config)
     table = emulator_predictions(emulator, design, shots)
     write_table(table, args.out, {"table": "emulator_predictions", "design": args.design, "emulator": args.emulator,
                                   "units": "m/s"})

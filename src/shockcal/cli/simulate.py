@@ -20,20 +20,20 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.config import shot_config
-    from shockcal.design import ShotMapping, load_design
     from shockcal.errors import InputError
     from shockcal.io import write_table
-    from shockcal.simulate import UNITS, hydro_inputs, simulate_design
-    from shockcal.stages import load_stage_config
+    from shockcal.simulate import UNITS, simulate_design
+    from shockcal.study.adapters import hydro_inputs, load_study_design, shot_mapping
+    from shockcal.study.config import shot_config
+    from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "simulate", args.shot)
     rows = slice(*parse_span(args.rows, "--rows"))
     if args.end_time_us is not None and args.end_time_us <= 0:
         raise InputError(f"--end-time-us: {args.end_time_us} is not a positive time")
-    mapping = ShotMapping.from_config(config, args.shot)
+    mapping = shot_mapping(config, args.shot)
     geometry, material, settings = hydro_inputs(config, shot_config(config, args.shot), args.end_time_us)
-    design = load_design(args.design, config, columns=mapping.inputs()).iloc[rows]
+    design = load_study_design(args.design, config, columns=mapping.inputs()).iloc[rows]
     mapping.check_positive(design, args.design)
     table = simulate_design(design, mapping, geometry, material, settings)
     units = {**UNITS, **{k: config["inputs"][k]["unit"] for k in mapping.inputs()}}

@@ -2,7 +2,7 @@
 
 These are what `run_shot` takes; each converts itself to the kernel's named tuples in code units
 (cm, us, g/cc, Mbar). Field names are the study config's keys (`material`, `hydro`), so
-`shockcal.simulate.hydro_inputs` builds them from a validated config by name alone.
+`shockcal.study.adapters.hydro_inputs` builds them from a validated config by name alone.
 """
 
 from __future__ import annotations
@@ -15,7 +15,13 @@ from shockcal.units import J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US
 
 @dataclass(frozen=True)
 class Geometry:
-    """A symmetric plate impact: flyer and target thickness (mm) and the simulated time (us)."""
+    """A symmetric plate impact.
+
+    Args:
+        flyer_mm: flyer plate thickness (mm).
+        target_mm: target plate thickness (mm); the measured free surface is its back.
+        end_us: simulated time after impact (us).
+    """
 
     flyer_mm: float
     target_mm: float
@@ -24,8 +30,17 @@ class Geometry:
 
 @dataclass(frozen=True)
 class MaterialProperties:
-    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and
-    target; `strain_rate_ref_per_s` is the Johnson-Cook reference rate eps0."""
+    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target.
+
+    Args:
+        rho0_g_cc: initial density (g/cc).
+        c1_Mbar, c2_Mbar, c3_Mbar: cold-curve coefficients P = c1 mu + c2 mu^2 + c3 mu^3 (Mbar).
+        gamma0: Grueneisen parameter (-); gamma0 rho0 is held constant.
+        T_ref_K: reference (room) temperature (K), where T* = 0.
+        T_melt_K: melting temperature (K), where T* = 1 and the strength vanishes.
+        cv_J_per_kg_K: specific heat (J/kg/K).
+        strain_rate_ref_per_s: the Johnson-Cook reference strain rate eps0 (1/s).
+    """
 
     rho0_g_cc: float
     c1_Mbar: float
@@ -58,8 +73,17 @@ AL5083 = MaterialProperties(rho0_g_cc=2.668, c1_Mbar=0.7797, c2_Mbar=0.2239, c3_
 
 @dataclass(frozen=True)
 class HydroSettings:
-    """Mesh, output sampling, artificial viscosity (q = rho (q_quadratic du^2 + q_linear c du)) and
-    time stepping; the defaults are the study config's (docs/hydro.md measures them)."""
+    """Mesh, output sampling, artificial viscosity and time stepping; the defaults are the study config's
+    (docs/hydro.md measures them).
+
+    Args:
+        cell_size_um: Lagrangian cell size (um).
+        output_dt_ns: sampling interval of the free-surface velocity history (ns).
+        cfl: Courant number of the time step (signal speed with the viscosity's).
+        dt_initial_us: first time step (us).
+        dt_max_us: largest time step (us).
+        q_linear, q_quadratic: artificial viscosity q = rho (q_quadratic du^2 + q_linear c du) (-).
+    """
 
     cell_size_um: float = 4.0
     output_dt_ns: float = 0.5

@@ -1,7 +1,8 @@
 """One hydrocode run of one shot, in user units: `run_shot(params, geometry, material, settings)`.
 
     from shockcal.hydro import Geometry, ShotParameters, run_shot
-    result = run_shot(ShotParameters(0.00335, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.269), Geometry(3.95, 5.965, 3.0))
+    params = ShotParameters(A_MPa=335, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
+    result = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=3.0))
 
 `result.t_us` and `result.v_m_s` are the target's free-surface velocity history (us, m/s).
 """
@@ -14,7 +15,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from shockcal.design import ShotParameters
+from shockcal.hydro.parameters import ShotParameters
 from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.solver import FAILURE_REASONS, STATUS_OK, Strength, simulate
 from shockcal.units import CM_US_TO_M_S, UM_TO_CM
@@ -42,30 +43,41 @@ STUDY_NUMERICS = HydroSettings()
 
 def run_shot(params: ShotParameters, geometry: Geometry, material: MaterialProperties = AL5083,
              settings: HydroSettings = STUDY_NUMERICS) -> RunResult:
-    """Simulate one symmetric shot to `geometry.end_us`. `params` holds the Johnson-Cook parameters,
-    the impact velocity and the shear modulus in the paper's units (Mbar, cm/us); the defaults are
-    Al-5083 and the study's numerics. A numerical failure is a result with status "failed" and a
-    reason naming the cell and time, never an exception."""
+    """Simulate one symmetric shot to `geometry.end_us`.
+
+    Args:
+        params: Johnson-Cook parameters, impact velocity and shear modulus (`ShotParameters`, user units).
+        geometry: flyer and target thickness (mm) and the simulated time (us).
+        material: EOS and thermal constants of flyer and target (default Al-5083, the paper's Table II).
+        settings: mesh, output sampling, artificial viscosity and time stepping (default the study's).
+
+    Returns:
+        A `RunResult`: free-surface velocity history (us, m/s) and diagnostics. A numerical failure is
+        a result with status "failed" and a reason naming the cell and time, never an exception.
+    """
     nf, nt = settings.cells(geometry.flyer_mm), settings.cells(geometry.target_mm)
     dt_out = settings.output_dt_us()
     t_out = np.arange(int(round(geometry.end_us / dt_out)) + 1) * dt_out
-    strength = Strength(float(params.shear_modulus_Mbar), float(params.A), float(params.B), float(params.C),
-                        float(params.n), float(params.m), material.rate_ref_per_us())
-    args = (nf, nt, settings.cell_size_um * UM_TO_CM, float(params.velocity_cm_us), strength,
-            material.code_units(), settings.numerics(), t_out)
-    load_kernel(simulate, args)
+    inputs = params.table_iv()
+    kernel_args = dict(nf=nf, nt=nt, dx=settings.cell_size_um * UM_TO_CM, velocity=inputs.velocity_cm_us,
+                       strength=Strength(inputs.shear_modulus_Mbar, inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n,
+                                         inputs.m, material.rate_ref_per_us()),
+                       material=material.code_units(), numerics=settings.numerics(), t_out=t_out)
+    load_kernel(simulate, tuple(kernel_args.values()))
     start = time.perf_counter()
-    v, energy, status, cell, t_fail, steps, max_rate, max_T, max_eps = simulate(*args)
+    out = simulate(**kernel_args)
     wall = time.perf_counter() - start
     reason = ""
-    if status != STATUS_OK:
-        where = f" in cell {cell}" if cell >= 0 else ""
-        body = "" if cell < 0 else (" (flyer)" if cell < nf else " (target)")
-        reason = f"{FAILURE_REASONS[status]}{where}{body} at t = {t_fail:.5f} us after {steps} steps"
+    if out.status != STATUS_OK:
+        where = f" in cell {out.fail_cell}" if out.fail_cell >= 0 else ""
+        body = "" if out.fail_cell < 0 else (" (flyer)" if out.fail_cell < nf else " (target)")
+        reason = f"{FAILURE_REASONS[out.status]}{where}{body} at t = {out.fail_time:.5f} us after {out.n_steps} steps"
+    energy = out.energy
     reached = energy[: max(1, np.count_nonzero(energy) or 1)]
     energy_error = float(np.max(np.abs(reached - energy[0])) / energy[0])
-    return RunResult(t_out, v * CM_US_TO_M_S, "ok" if status == STATUS_OK else "failed", reason,
-                     max_rate, max_T, max_eps, energy_error, int(steps), wall, energy)
+    return RunResult(t_out, out.v_free_surface * CM_US_TO_M_S, "ok" if out.status == STATUS_OK else "failed", reason,
+                     out.max_plastic_rate, out.max_temperature, out.max_plastic_strain, energy_error,
+                     int(out.n_steps), wall, energy)
 
 
 def load_kernel(kernel, args) -> None:

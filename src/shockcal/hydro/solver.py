@@ -2,16 +2,29 @@
 
 Units inside: cm, us, g/cc, Mbar (1 Mbar = 1 g/cc (cm/us)^2); specific energy in (cm/us)^2.
 
-Mesh (`Nodes`, `Cells`): nodes 0..N+1, cells 0..N, cell j between nodes j and j+1. The flyer's cells are 0..nf-1,
-the target's nf+1..N; cell nf is the contact gap between the flyer's rear node nf and the
-target's front node nf+1 (no mass, no stress, its length is the gap). Both outer nodes are free
-surfaces. Each step (leapfrog), one kernel per line:
+Mesh (`Nodes`, `Cells`): nodes 0..N+1, cells 0..N (N = nf + nt), cell j between nodes j and j+1:
+
+       flyer (moving at the impact velocity)           gap          target (at rest)
+    |-------|-------| ... |-------|               |--------|------| ... |-------|
+    0  c0   1  c1   2      nf-1   nf     c_nf     nf+1  c_nf+1          N  c_N  N+1
+    ^ free surface (flyer's back)    contact gap:            measured free surface ^ u[N+1]
+                                     no mass, no stress,
+                                     length = the gap (0 at impact)
+
+    node i:  velocity u, lumped mass (half of each neighbouring cell's)       (`Nodes`)
+    cell j:  length, E, P, deviator s, sigma = -(P + q) + s, eps_p, floors    (`Cells`)
+    q, the artificial viscosity, is computed per cell and step and lives only in sigma.
+
+The flyer's cells are 0..nf-1, the target's nf+1..N; cell nf is the contact gap between the flyer's
+rear node nf and the target's front node nf+1. Both outer nodes are free surfaces. Each step
+(leapfrog), one kernel per line:
 1. `accelerate_nodes`: u += dt (sigma_right - sigma_left) / m_node, sigma = -(P + q) + s;
 2. `close_contact`: if the gap would close, the two interface nodes take their common momentum
    velocity and the energy an impact dissipates goes to the interface cells; under tension the
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
-   only), elastic trial deviator and Johnson-Cook radial return, energy equation, EOS;
+   only), elastic trial deviator and Johnson-Cook radial return (skipped while the trial lies inside
+   the cell's flow-stress floor: `floor_at`, `set_floor`), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
@@ -83,6 +96,20 @@ class Numerics(NamedTuple):
     cfl: float
     dt_initial: float
     dt_max: float
+
+
+class KernelResult(NamedTuple):
+    """What `simulate` returns (code units: cm/us, Mbar cm, us, K)."""
+
+    v_free_surface: np.ndarray   # target's free-surface velocity at t_out, cm/us
+    energy: np.ndarray           # total energy per unit area at t_out (zero past a failure), Mbar cm
+    status: int                  # STATUS_OK or a failure code (FAILURE_REASONS)
+    fail_cell: int               # the failed cell, or -1
+    fail_time: float             # us
+    n_steps: int
+    max_plastic_rate: float      # 1/us, over the target's cells
+    max_temperature: float       # K
+    max_plastic_strain: float
 
 
 class Nodes(NamedTuple):
@@ -220,6 +247,26 @@ def johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material):
 
 
 @njit(cache=True, error_model="numpy")
+def floor_at(j, T_cell, flow_floor, floor_hotter, floor_T):
+    """Cell j's flow-stress floor at temperature T_cell (K): the floor set at floor_T[j] while the cell
+    is no hotter, the hotter one up to FLOOR_MARGIN_K above it, else -1 (none holds)."""
+    if T_cell <= floor_T[j]:
+        return flow_floor[j]
+    if T_cell <= floor_T[j] + FLOOR_MARGIN_K:
+        return floor_hotter[j]
+    return -1.0
+
+
+@njit(cache=True, error_model="numpy")
+def set_floor(j, T_cell, hard, thermal, thermal_hotter, flow_floor, floor_hotter, floor_T):
+    """After a full evaluation of cell j's flow stress at T_cell (K): its floors (A + B eps_p^n) times the
+    thermal factor at T_cell and its bound FLOOR_MARGIN_K hotter, each just below by FLOOR_SLACK."""
+    floor_T[j] = T_cell
+    flow_floor[j] = FLOOR_SLACK * hard * thermal
+    floor_hotter[j] = FLOOR_SLACK * hard * thermal_hotter
+
+
+@njit(cache=True, error_model="numpy")
 def inside_floor(equivalent_stress, flow_floor, strain_rate, strength):
     """Whether a trial von Mises stress is provably elastic: inside the rate-free floor, or (one log)
     inside the floor times the Johnson-Cook rate factor. A negative floor means none holds."""
@@ -269,8 +316,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
         T_cell = material.T_ref + E[j] / material.cv
-        floor = flow_floor[j] if T_cell <= floor_T[j] else (
-            floor_hotter[j] if T_cell <= floor_T[j] + FLOOR_MARGIN_K else -1.0)
+        floor = floor_at(j, T_cell, flow_floor, floor_hotter, floor_T)
         if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
             s_new, d_eps = s_trial, 0.0
         else:
@@ -279,9 +325,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
             if d_eps > 0.0:
                 eps_p[j] += d_eps
                 hard[j] = hardening(strength.A, strength.B, strength.n, eps_p[j])
-            floor_T[j] = T_cell
-            flow_floor[j] = FLOOR_SLACK * hard[j] * thermal
-            floor_hotter[j] = FLOOR_SLACK * hard[j] * thermal_hotter
+            set_floor(j, T_cell, hard[j], thermal, thermal_hotter, flow_floor, floor_hotter, floor_T)
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)
@@ -315,8 +359,18 @@ def grow_window(sigma, lo, hi):
 
 @njit(cache=True, error_model="numpy")
 def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
-    """Run to t_out[-1]; returns (v_free_surface, energy_at_outputs, status, fail_cell, fail_time,
-    n_steps, max_plastic_rate, max_T, max_eps_p), the maxima over the target's cells."""
+    """Run to t_out[-1] (us): a `KernelResult` (free-surface velocity and total energy at t_out, status,
+    failed cell and time, steps, the maxima over the target's cells).
+
+    Args:
+        nf, nt: cells across the flyer and the target.
+        dx: cell size (cm).
+        velocity: impact velocity of the flyer (cm/us).
+        strength: `Strength` (Mbar, -, 1/us).
+        material: `Material` (code units).
+        numerics: `Numerics` (artificial viscosity, CFL, time steps in us).
+        t_out: output times (us), t_out[0] = 0.
+    """
     nodes, cells = initial_mesh(nf, nt, dx, velocity, strength, material)
     u = nodes.u
     N = nf + nt
@@ -340,7 +394,7 @@ def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
         status, cell, max_signal_rate = update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics,
                                                      peaks)
         if status != STATUS_OK:
-            return v_out, energy_out, status, cell, t, steps, peaks[0], peaks[1], peaks[2]
+            return KernelResult(v_out, energy_out, status, cell, t, steps, peaks[0], peaks[1], peaks[2])
         lo, hi = grow_window(cells.sigma, lo, hi)
         # free-surface velocity (time-centred at t + dt/2), linearly interpolated onto t_out
         t_mid = t + 0.5 * dt
@@ -354,5 +408,5 @@ def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
         steps += 1
         dt = min(numerics.cfl / max_signal_rate, DT_GROWTH * dt)
         if dt < DT_FLOOR_US:
-            return v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2]
-    return v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2]
+            return KernelResult(v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2])
+    return KernelResult(v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2])

@@ -82,7 +82,7 @@ class FigureSpec:
     name: str
     category: str
     build: Callable  # (FigureInputs, config) -> matplotlib Figure
-    reads: tuple[str, ...] = ()  # config keys `build` reads besides `figures` (shockcal.stages paths)
+    reads: tuple[str, ...] = ()  # config keys `build` reads besides `figures` (shockcal.study.stages paths)
     needs: tuple[str, ...] = ()  # FigureInputs keys `build` reads, for the config's shots (kinds: INPUT_KINDS)
 
 
@@ -105,10 +105,11 @@ def _records(inputs, config):
 
 def _trace_figure(which, inputs, config):
     from shockcal.plots import mixture
+    from shockcal.study.adapters import extractor_settings
 
     shot = _shots(config)[0]
     trace, label = mixture.pick_trace(inputs.record(shot, config), inputs.table(f"sample_simulations:{shot}"), shot)
-    return getattr(mixture, which)(trace, label, config, shot)
+    return getattr(mixture, which)(trace, label, extractor_settings(config, shot))
 
 
 def _crossval(inputs, config):

@@ -44,21 +44,21 @@ class TraceExtraction:
         return pd.Series(self.ex.features)
 
 
-def extract_view(trace: pd.DataFrame, config: dict, shot: str) -> TraceExtraction:
-    """Run the project's extractor on `trace` with the shot's analysis settings."""
-    from shockcal.features import ExtractorSettings, extract
+def extract_view(trace: pd.DataFrame, settings) -> TraceExtraction:
+    """Run the project's extractor on `trace` with the shot's `ExtractorSettings`."""
+    from shockcal.features import extract
 
     t, v = trace["t_us"].to_numpy(float), trace["v_m_s"].to_numpy(float)
-    ex = extract(t, v, ExtractorSettings.from_config(config, shot))
+    ex = extract(t, v, settings)
     return TraceExtraction(t, v, ex)
 
 
-def _view_or_note(trace, label, config, shot):
+def _view_or_note(trace, label, settings):
     """(view, None) or (None, reason) when there is no trace or the extractor refuses it."""
     if trace is None:
         return None, label
     try:
-        return extract_view(trace, config, shot), None
+        return extract_view(trace, settings), None
     except (InputError, ValueError) as exc:
         return None, f"extractor failed on {label}: {exc}"
 
@@ -72,11 +72,11 @@ def _mixture_pdf(view: TraceExtraction, grid, which):
 
 
 @styled
-def fig04_trace_features(trace, label: str, config: dict, shot: str):
+def fig04_trace_features(trace, label: str, settings):
     """The five features marked on the trace, the analysis window shaded."""
     fig, axes = subplots(1, 1, width=6.5, height=4.0)
     ax = axes[0, 0]
-    view, problem = _view_or_note(trace, label, config, shot)
+    view, problem = _view_or_note(trace, label, settings)
     if view is None:
         no_data(ax, problem)
         return fig
@@ -98,11 +98,11 @@ def fig04_trace_features(trace, label: str, config: dict, shot: str):
 
 
 @styled
-def fig05_mixture_split(trace, label: str, config: dict, shot: str):
+def fig05_mixture_split(trace, label: str, settings):
     """PIT samples with the fitted mixture, components split into early and late at the cut-off."""
     fig, axes = subplots(1, 1, width=6.5, height=4.0)
     ax = axes[0, 0]
-    view, problem = _view_or_note(trace, label, config, shot)
+    view, problem = _view_or_note(trace, label, settings)
     if view is None:
         no_data(ax, problem)
         return fig
@@ -124,11 +124,11 @@ def fig05_mixture_split(trace, label: str, config: dict, shot: str):
 
 
 @styled
-def fig15_pit_construction(trace, label: str, config: dict, shot: str, n_arrows: int = 9):
+def fig15_pit_construction(trace, label: str, settings, n_arrows: int = 9):
     """The standardized trace read as a CDF: uniform draws mapped through its inverse to times."""
     fig, axes = subplots(2, 1, width=6.0, height=5.6, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     top, bottom = axes[:, 0]
-    view, problem = _view_or_note(trace, label, config, shot)
+    view, problem = _view_or_note(trace, label, settings)
     if view is None:
         for ax in (top, bottom):
             no_data(ax, problem)

@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from shockcal.config import input_names
 from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots, to_display
 
 # Gray et al. Johnson-Cook fits for Al-5083 (SPEC section 3), display units (A, B in MPa).
@@ -55,7 +54,7 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
 
     `posteriors` maps a calibration name to its samples; None or an empty table gives a "no data" row.
     """
-    names = input_names(config)
+    names = list(config["inputs"])     # every input, in the design's order
     rows = list(posteriors)
     fig, axes = subplots(len(rows), len(names), width=1.55 * len(names), height=1.35 * len(rows) + 0.9)
     for r, calib in enumerate(rows):
@@ -98,7 +97,7 @@ def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
     """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it."""
     from scipy.ndimage import gaussian_filter
 
-    names = input_names(config)
+    names = list(config["inputs"])     # every input, in the design's order
     k = len(names)
     fig, axes = subplots(k, k, width=1.25 * k + 0.5, height=1.25 * k + 0.5)
     if samples is None or samples.empty:

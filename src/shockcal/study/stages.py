@@ -17,8 +17,9 @@ from __future__ import annotations
 import copy
 from collections.abc import Iterable, Iterator
 
-from shockcal.config import load_config, shot_config
-from shockcal.design import ShotMapping
+from shockcal.study.adapters import shot_mapping
+from shockcal.study.config import shot_config
+from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
@@ -102,7 +103,7 @@ def _expand(config: dict, parts: list[str], shot: str | None, stage: str) -> Ite
             parts = [*parts[:i], shot, *parts[i + 1:]]
         elif part in ("*", "{shot_inputs}"):
             node = _node(config, parts[:i], f"{stage}: {'.'.join(parts)}")
-            keys = node if part == "*" else ShotMapping.from_config(config, shot).inputs()
+            keys = node if part == "*" else shot_mapping(config, shot).inputs()
             for key in keys:
                 yield from _expand(config, [*parts[:i], key, *parts[i + 1:]], shot, stage)
             return

@@ -1,27 +1,24 @@
 """Study configuration: load YAML, validate against the JSON schema, check cross-field rules.
 
-The schema (config.schema.yaml beside this file, also used by the Snakefile) fills defaults and
-checks types and ranges; `check_semantics` adds the rules a schema cannot express. Relative paths
+The schema (src/shockcal/config.schema.yaml, also used by the Snakefile) fills defaults and
+checks types and ranges; `check_semantics` adds the rules a schema cannot express, and
+`check_design_file` reads the config's design file through the study's own design loader. Relative paths
 in a config (design.file, observed.records.*.path) are relative to the working directory, which
 for the workflow is the repository root.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import yaml
 
 from shockcal.errors import ConfigError, InputError, ShockcalError
+from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plausibility import check_observed
-from shockcal.units import MM_TO_CM
+from shockcal.study.adapters import load_study_design
 
-SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
-
-# Johnson-Cook strength inputs shared by every shot (SPEC section 3), in Table IV units.
-STRENGTH_INPUTS = ("A", "B", "C", "n", "m")
-AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
+SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
 
 def load_config(path: str | Path) -> dict:
@@ -48,6 +45,7 @@ def validate_config(config: dict, source: str = "config") -> dict:
     except ValidationError as exc:
         raise ConfigError(f"{source}: {_schema_message(exc)}") from None
     check_semantics(config, source)
+    check_design_file(config, source)
     return config
 
 
@@ -97,14 +95,14 @@ def _schema_message(exc) -> str:
 
 def check_semantics(config: dict, source: str = "config") -> None:
     """Rules beyond the schema: box bounds ordered, shot mappings and sampler powers name real inputs, files
-    exist, the design file's contents pass `load_design`, observed features look like m/s and us (shockcal.plausibility)."""
+    exist, observed features look like m/s and us (shockcal.plausibility)."""
     inputs = config["inputs"]
     for name, box in inputs.items():
         if not box["min"] < box["max"]:
             raise ConfigError(f"{source}: inputs.{name}: min ({box['min']}) must be below max ({box['max']})")
-    for name in STRENGTH_INPUTS:
+    for name in JOHNSON_COOK_INPUTS:
         if name not in inputs:
-            raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {STRENGTH_INPUTS} are required")
+            raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {JOHNSON_COOK_INPUTS} are required")
         if inputs[name]["min"] < 0:
             raise ConfigError(f"{source}: inputs.{name}.min: Johnson-Cook parameters cannot be negative")
     for shot, spec in config["shots"].items():
@@ -135,43 +133,15 @@ def check_semantics(config: dict, source: str = "config") -> None:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
                               f"{'published' if source_section == 'records' else 'records'}")
-    if design_file:
-        from shockcal.design import load_design  # shockcal.design imports this module
-
-        try:
-            load_design(design_file, config)
-        except InputError as exc:
-            raise ConfigError(f"{source}: design.file: {exc}") from None
 
 
-def shot_config(config: dict, shot: str) -> dict:
-    """The config block of one shot, or a ConfigError listing the known shots."""
+def check_design_file(config: dict, source: str = "config") -> None:
+    """The config's design file (`design.file`), if any, read and checked as every stage will read it
+    (finite, inside the prior box, ...), so that a bad file stops the config's load with its row."""
+    design_file = config["design"].get("file")
+    if not design_file:
+        return
     try:
-        return config["shots"][shot]
-    except KeyError:
-        raise ConfigError(f"unknown shot '{shot}'; the config defines {sorted(config['shots'])}") from None
-
-
-def end_time_us(config: dict, shot: dict) -> float:
-    """Simulated time of a run of `shot` (us): `hydro.end_time_us`, or with `auto` the latest time
-    the feature extractor can need. The free surface starts to move no later than target / c0 after
-    impact (the elastic precursor travels faster than the bulk sound speed c0 = sqrt(c1 / rho0));
-    the analysis window ends `window_after_arrival_us` later; AUTO_END_MARGIN_US is added. A run whose
-    window still reaches past its end fails in the extractor with a reason, never silently."""
-    requested = config["hydro"]["end_time_us"]
-    if requested != "auto":
-        return float(requested)
-    material = config["material"]
-    c0_cm_us = math.sqrt(material["eos"]["c1_Mbar"] / material["rho0_g_cc"])
-    window = shot["analysis"]["window_after_arrival_us"]
-    return shot["target_mm"] * MM_TO_CM / c0_cm_us + window + AUTO_END_MARGIN_US
-
-
-def input_names(config: dict) -> list[str]:
-    """All calibration inputs in config order (the design table's columns)."""
-    return list(config["inputs"])
-
-
-def prior_bounds(config: dict) -> dict[str, tuple[float, float]]:
-    """The prior box, input by input in config order: name -> (min, max) in the box's native units."""
-    return {name: (box["min"], box["max"]) for name, box in config["inputs"].items()}
+        load_study_design(design_file, config)
+    except InputError as exc:
+        raise ConfigError(f"{source}: design.file: {exc}") from None

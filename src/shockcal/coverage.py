@@ -1,0 +1,188 @@
+"""Synthetic-truth checks of the calibration: truths from the emulator or from hydrocode runs,
+pseudo-measurements with the observation noise, and the coverage of the 90% intervals."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from shockcal.calibration import CalibrationSettings, calibrate
+from shockcal.errors import InputError, ShockcalError
+from shockcal.features import CALIBRATION_FEATURES
+from shockcal.problem import LAMBDA_Y_PRIOR, Problem, log_density
+
+log = logging.getLogger("shockcal.calibration")
+
+
+def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None) -> pd.DataFrame:
+    """Calibrate on synthetic truth with a known theta; one row per trial and parameter.
+
+    `trials` is a count or the trial numbers to run (a range): each trial draws from its own random
+    stream (child `trial` of `seed`), so a check split into batches of trials (the workflow's jobs)
+    gives the same rows as one run. A trial draws lambda_y from its prior and takes theta and
+    noise-free features either from the emulator (theta uniform on the box, features from its
+    predictive distribution at theta) or, when `truths` is given, from hydrocode run number `trial`
+    among the usable ones (`HydroTruths`). Observation noise of sd = sd_fraction / sqrt(lambda_y) of
+    each feature is added and the features are calibrated with `settings` (the sampler reseeded from
+    the trial's stream). Columns:
+    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS),
+    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows), status ("ok" or
+    "failed") and reason. A trial that fails (the sampler at `max_evaluations`, no positive noise draw)
+    is recorded with its reason and empty results, and the next one runs; the coverage leaves it out
+    (`usable_trials`) and counts it.
+    """
+    trial_ids = range(trials) if isinstance(trials, int) else trials
+    names = emulator.required_inputs(shots)
+    hydro_draws = None if truths is None else truths.table(names, shots)
+    if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
+        raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
+                         f"but only {len(hydro_draws)} truth runs are usable")
+    rows = []
+    for done, trial in enumerate(trial_ids, 1):
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
+        try:
+            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws)
+        except ShockcalError as error:     # recorded and left out of the coverage, never the end of the batch
+            log.warning("synthetic trial %d failed: %s", trial, error)
+            rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
+                     for name in [*names, "lambda_y"]]
+        log.info("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))
+    table = pd.DataFrame(rows, columns=CHECK_COLUMNS)
+    table["inside"] = table["inside"].astype("boolean")
+    return table
+
+
+CHECK_COLUMNS = ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass", "status", "reason"]
+
+
+def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws) -> list[dict]:
+    """One synthetic-truth trial: its truth, pseudo-measurement and calibration; a row per parameter."""
+    if hydro_draws is None:
+        theta, eta = _emulator_truth(emulator, shots, names, rng)
+    else:
+        theta, eta = hydro_draws[trial]
+    lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial)
+    observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
+    trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
+    posterior = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
+    draws, summary = posterior.draws, posterior.summary().set_index("parameter")
+    problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)
+    truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
+    mass = hpd_mass(log_density(draws["log_likelihood"], draws["lambda_y"]), log_density(truth_ll, lam))
+    rows = []
+    for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
+        q05, q95 = summary.loc[name, ["q05", "q95"]]
+        rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
+                     "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
+                     "truth_hpd_mass": mass, "status": "ok", "reason": ""})
+    return rows
+
+
+def hpd_mass(draw_log_density, truth_log_density: float) -> float:
+    """Share of equal-weight posterior draws denser than the truth: the mass of the smallest credible
+    region that holds it. Uniform on [0, 1] when the truths come from the prior and the posterior is
+    right, whatever its shape; unlike the per-parameter intervals, one joint number per trial."""
+    return float(np.mean(np.asarray(draw_log_density) > truth_log_density))
+
+
+def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
+    """(lambda_y, pseudo-measured features): lambda_y from its prior and noise of sd = sd_fraction /
+    sqrt(lambda_y) of each feature. No measurement reports a non-positive feature: such a draw is
+    drawn again (the features are conditioned on being positive)."""
+    for _ in range(attempts):
+        lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1])
+        y = eta + sd_fraction * np.abs(eta) / np.sqrt(lam) * rng.normal(size=eta.shape)
+        if np.all(y > 0):
+            return lam, y
+    raise InputError(f"synthetic trial {trial}: {attempts} noise draws all gave a non-positive feature "
+                     f"(noise-free features {np.round(eta, 3).tolist()})")
+
+
+def _emulator_truth(emulator, shots, names, rng):
+    """(theta, features): theta uniform on the box, features from the emulator's predictive
+    distribution at theta (its error model's, block by block)."""
+    lower, upper = emulator.input_bounds(names)
+    theta = rng.uniform(lower, upper)
+    mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
+    features = np.empty(mean.shape[1])
+    for cols, error in emulator.error_groups(shots):
+        features[cols] = error.sample(mean[0, cols], cov[0, cols[:, None], cols[None, :]], rng)
+    return theta, features
+
+
+@dataclass
+class HydroTruths:
+    """Hydrocode runs as synthetic truth: their design (theta per run) and, per shot, their features."""
+
+    design: pd.DataFrame
+    features: dict            # shot -> features table (run, status, feature columns)
+
+    @classmethod
+    def read(cls, design_path, feature_paths: dict, shots) -> HydroTruths:
+        """From a design table and each shot's features table (CSV or Parquet); every shot calibrated
+        needs its features."""
+        from shockcal.io import read_table
+
+        missing = sorted(set(shots) - set(feature_paths))
+        if missing:
+            raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
+        return cls(read_table(design_path), {shot: read_table(path) for shot, path in feature_paths.items()})
+
+    def table(self, names, shots) -> list:
+        """(theta, features) of each usable run (every shot's features ok and positive), in run order."""
+        table = self.design.set_index("run")
+        for shot in shots:
+            ok = self.features[shot].query("status == 'ok'").set_index("run")
+            table = table.join(ok[CALIBRATION_FEATURES].add_prefix(f"{shot}:"), how="inner")
+        columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES]
+        usable = table[(table[columns] > 0).all(axis=1)].sort_index()
+        log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable), len(self.design))
+        return list(zip(usable[names].to_numpy(float), usable[columns].to_numpy(float)))
+
+
+def usable_trials(trials: pd.DataFrame) -> pd.DataFrame:
+    """The rows of trials that finished: status "ok", or no status (rows from before the status
+    column, 2026-11-25, are all of finished trials)."""
+    return trials if "status" not in trials else trials[trials["status"].fillna("ok") == "ok"]
+
+
+def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
+    """Per parameter, over the trials that finished (`usable_trials`; failed_trials counts the others):
+    trials, share of 90% intervals holding the truth (nominal 0.90), the central 95% binomial band of
+    that share for a calibrated method (band_low, band_high), whether it lies in the band, the shares
+    of truths below q05 and above q95 (nominal 0.05 each: a lopsided miss points to a shifted
+    posterior, an even one to a narrow one), and the smallest Kish ESS of any trial."""
+    usable = usable_trials(trials).astype({"inside": bool})
+    usable = usable.assign(below_q05=usable["truth"] < usable["q05"], above_q95=usable["truth"] > usable["q95"])
+    if usable.empty:
+        reasons = trials.groupby("trial")["reason"].first() if "reason" in trials else pd.Series(dtype=str)
+        raise InputError(f"no synthetic-truth trial finished: {len(reasons)} failed"
+                         + (f", the first with: {reasons.iloc[0]}" if len(reasons) else ""))
+    table = usable.groupby("parameter", sort=False).agg(
+        trials=("trial", "nunique"), coverage90=("inside", "mean"), below_q05=("below_q05", "mean"),
+        above_q95=("above_q95", "mean"), min_ess=("ess", "min")).reset_index()
+    failed = trials.groupby("parameter", sort=False)["trial"].nunique() - usable.groupby("parameter")["trial"].nunique()
+    table["failed_trials"] = table["parameter"].map(failed).fillna(0).astype(int)
+    table["band_low"], table["band_high"] = binomial_band(table["trials"])
+    table["within_band"] = table["coverage90"].between(table["band_low"], table["band_high"])
+    return table
+
+
+def joint_coverage(trials: pd.DataFrame) -> dict:
+    """The joint check from the trials' `truth_hpd_mass`: the share of trials whose truth lies in the
+    90% highest-density region, its central 95% binomial band, and the Kolmogorov-Smirnov p-value of
+    the masses against the uniform distribution they follow for a calibrated method."""
+    mass = usable_trials(trials).groupby("trial")["truth_hpd_mass"].first().to_numpy()
+    band_low, band_high = binomial_band(len(mass))
+    return {"trials": len(mass), "coverage90": float(np.mean(mass <= 0.9)), "band_low": band_low,
+            "band_high": band_high, "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}
+
+
+def binomial_band(trials):
+    """The central 95% band of the share of `trials` (a count or an array of counts) that a
+    calibrated 90% interval covers."""
+    return stats.binom.ppf(0.025, trials, 0.9) / trials, stats.binom.ppf(0.975, trials, 0.9) / trials

@@ -1,0 +1,169 @@
+"""The posterior density of a calibration: a predictive model, measured features, a prior box (SPEC sections 5-6).
+
+For the shots calibrated together, the measured features y (m/s, four per shot) are modelled as
+
+    y = eta(theta) + e + eps,   e ~ t_nu(0, s C_eta(theta)),   eps ~ N(0, Sigma_y / lambda_y),
+
+eta and C_eta the emulator's predictive mean and covariance, (nu, s) its error model (a Student t
+fitted to its K-fold errors, `shockcal.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
+e per emulator block (their errors are independent), Sigma_y diagonal with sd =
+`observed.sd_fraction` (1%) of each measured feature, lambda_y ~ Gamma(5, 5), theta uniform on the
+prior box. The emulator's hyperparameters are fixed at their fitted mode (modular Bayes; see
+docs/calibration.md). A point is (theta in native units, lambda_y); both priors are reached from the
+unit cube (`Problem.prior_transform`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from shockcal.error_model import ErrorModel
+from shockcal.errors import InputError
+
+LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
+
+
+@dataclass
+class Problem:
+    """Everything the posterior density needs: a predictive model, observed features, prior box.
+
+    `predict` maps theta (N, d) in native units to the predictive mean (N, F) and covariance
+    (N, F, F) of the features, m/s: any emulator (`PCGPEmulator.predict` from a notebook, or a
+    study's `Emulator` through `Problem.for_shots`). Points are (theta, lambda_y). `prior_transform`
+    and `log_likelihood` are the pair a nested or SMC sampler takes (vectorised over a batch of
+    points); `log_posterior` is the same density for MCMC in (theta, log lambda_y).
+    `error_groups`: (feature columns, ErrorModel) pairs covering the features once; default, one
+    Gaussian over all of them.
+    """
+
+    predict: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+    observed: np.ndarray      # (F,) m/s
+    obs_sd: np.ndarray        # (F,) m/s
+    names: list[str]          # calibrated inputs, native units
+    lower: np.ndarray
+    upper: np.ndarray
+    label: str = "calibration"
+    error_groups: list[tuple[np.ndarray, ErrorModel]] | None = None
+
+    @classmethod
+    def from_emulator(cls, emulator, *, observed, sd_fraction: float = 0.01, names=None, label: str = "calibration"
+                      ) -> Problem:
+        """The problem of an array-level emulator (`PCGPEmulator`), its prior box and error model.
+
+        Args:
+            emulator: a fitted `PCGPEmulator` (its box is the prior box, its error model the likelihood's).
+            observed: measured features (F,), m/s, in the emulator's output order.
+            sd_fraction: observation sd as a fraction of each measured feature (0.01: 1%).
+            names: the inputs' names (default the emulator's `input_names`).
+            label: names the problem in messages.
+        """
+        y = np.asarray(observed, dtype=float)
+        names = list(emulator.input_names if names is None else names)
+        return cls(emulator.predict, y, sd_fraction * np.abs(y), names, np.asarray(emulator.lower, dtype=float),
+                   np.asarray(emulator.upper, dtype=float), label, emulator.error_groups())
+
+    @classmethod
+    def for_shots(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed"
+                  ) -> Problem:
+        """The study's problem: the inputs `shots` need, their box, and their measured features.
+
+        Args:
+            emulator: the study's `Emulator` (design inputs in native units).
+            shots: the shots calibrated together (one: a single-shot calibration).
+            observed_table: measured features, one row per shot (m/s).
+            sd_fraction: observation sd as a fraction of each measured feature.
+            source: names the table in errors.
+        """
+        names = emulator.required_inputs(shots)
+        lower, upper = emulator.input_bounds(names)
+        y = observed_vector(observed_table, shots, emulator.feature_names, source)
+
+        def predict(theta):
+            return emulator.predict(dict(zip(names, theta.T)), list(shots))
+
+        return cls(predict, y, sd_fraction * np.abs(y), names, np.asarray(lower), np.asarray(upper), "+".join(shots),
+                   emulator.error_groups(shots))
+
+    @property
+    def ndim(self) -> int:
+        return len(self.names) + 1
+
+    def prior_transform(self, u: np.ndarray) -> np.ndarray:
+        """Unit cube (N, d + 1) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5))."""
+        u = np.atleast_2d(u)
+        shape, rate = LAMBDA_Y_PRIOR
+        theta = self.lower + u[:, :-1] * (self.upper - self.lower)
+        return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
+
+    def cube_power(self, powers: Mapping[str, float], others: str = "error") -> np.ndarray:
+        """`nested_sample`'s per-coordinate unit-cube power from powers of named inputs (1 for the
+        others and lambda_y). A name this problem does not calibrate is an error, or with
+        `others="ignore"` skipped (a study's powers in a single-shot calibration: 104S has no Delta2)."""
+        unknown = sorted(set(powers) - set(self.names))
+        if unknown and others != "ignore":
+            raise InputError(f"{self.label}: calibration.cube_power names {unknown}, not among the calibrated "
+                             f"inputs {self.names}")
+        return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0])
+
+    def log_likelihood(self, points: np.ndarray) -> np.ndarray:
+        """Log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
+        inside the box, normalising constants included (so the evidence is a true marginal likelihood).
+        A non-finite value is an error naming the point: it means the emulator is broken there."""
+        points = np.atleast_2d(points)
+        theta, lam = points[:, :-1], points[:, -1]
+        mean, cov = self.predict(theta)
+        resid = self.observed - mean
+        groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
+        value = np.zeros(len(points))
+        for cols, error in groups:
+            noise_var = self.obs_sd[cols] ** 2 / lam[:, None]
+            value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_var)
+        bad = ~np.isfinite(value)
+        if bad.any():
+            point = dict(zip([*self.names, "lambda_y"], points[np.argmax(bad)].tolist()))
+            raise InputError(f"{self.label}: the log-likelihood is not finite at {point} "
+                             "(the emulator's prediction or covariance is invalid there)")
+        return value
+
+    def log_posterior(self, x: np.ndarray) -> np.ndarray:
+        """Log posterior (up to a constant) at x (N, d + 1) = (theta, log lambda_y); -inf outside the
+        box. The Gamma prior of lambda_y and the Jacobian of the log are included."""
+        x = np.atleast_2d(x)
+        out = np.full(len(x), -np.inf)
+        inside = np.all((x[:, :-1] >= self.lower) & (x[:, :-1] <= self.upper), axis=1) & np.isfinite(x[:, -1])
+        if inside.any():
+            log_lam = x[inside, -1]
+            lam = np.exp(log_lam)
+            shape, rate = LAMBDA_Y_PRIOR
+            out[inside] = self.log_likelihood(np.column_stack([x[inside, :-1], lam])) + shape * log_lam - rate * lam
+        return out
+
+
+def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> np.ndarray:
+    """The measured features of `shots`, shot-major; missing or non-positive values are errors."""
+    from shockcal.io import require_columns  # pyarrow's import is paid only by the study
+
+    require_columns(table, ["shot", *feature_names], source)
+    values = []
+    for shot in shots:
+        rows = table[table["shot"].astype(str) == shot]
+        if rows.empty:
+            raise InputError(f"{source}: no observed features for shot {shot} (have {sorted(table['shot'].astype(str))})")
+        row = rows.iloc[0][feature_names].to_numpy(dtype=float)
+        bad = [f for f, v in zip(feature_names, row) if not np.isfinite(v) or v <= 0]
+        if bad:
+            raise InputError(f"{source}: shot {shot}: observed feature(s) {bad} missing or not positive")
+        values.append(row)
+    return np.concatenate(values)
+
+
+def log_density(log_likelihood, lambda_y):
+    """Log posterior density of (theta, lambda_y) up to a constant: the log-likelihood plus lambda_y's
+    Gamma prior (theta's prior is uniform on the box)."""
+    shape, rate = LAMBDA_Y_PRIOR
+    return np.asarray(log_likelihood) + stats.gamma.logpdf(lambda_y, shape, scale=1.0 / rate)

@@ -1,0 +1,12 @@
+"""The study: the one room that reads the study config (config/config.yaml).
+
+Layers, each importing only those above it and the library:
+- `config`: accessors of a validated config (a shot's section, the inputs, the prior box, the end time);
+- `adapters`: the config turned into the library's typed settings (`hydro_inputs`, `extractor_settings`,
+  `emulator_spec`, `calibration_settings`, ...), the design and the measured features of the study;
+- `validate`: reading a config file, its schema and the rules across keys, the design file's check;
+- `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands.
+
+The library (hydro, design, features, emulator, calibration, ...) never imports this package: the
+`shockcal` commands call an adapter, and the adapter hands the library typed settings.
+"""

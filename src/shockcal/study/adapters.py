@@ -1,0 +1,142 @@
+"""The study config turned into the library's typed settings: one adapter per setting, in one place.
+
+Each adapter takes a validated config (or the slice its stage reads, `shockcal.study.stages`) and
+returns what a library function takes; the library never sees a dict. Field names of the settings
+are the config's keys, so most adapters copy by name. The emulator's, the calibration's and the
+extractor's modules are imported by their adapters, so that a simulate job does not pay for them
+(0.7 s a job).
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields
+from typing import TYPE_CHECKING
+
+from shockcal.design import InputBox, ShotMapping, latin_hypercube, load_design
+from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
+from shockcal.seeds import stream_seed
+from shockcal.study.config import end_time_us, prior_bounds, shot_config
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from shockcal.calibration import CalibrationSettings
+    from shockcal.emulator import EmulatorSpec
+    from shockcal.features import ExtractorSettings
+    from shockcal.pcgp import Settings as EmulatorSettings
+
+
+def input_box(config: dict) -> InputBox:
+    """The prior box (`inputs`), the shots' velocity inputs (for messages) and `checks.design_box`."""
+    return InputBox(prior_bounds(config), {name: box["unit"] for name, box in config["inputs"].items()},
+                    {spec["velocity_input"]: shot for shot, spec in config["shots"].items()},
+                    config["checks"]["design_box"])
+
+
+def shot_mapping(config: dict, shot: str) -> ShotMapping:
+    """How `shot` reads a design row (`shots.<shot>`; a ConfigError names an unknown shot)."""
+    spec = shot_config(config, shot)
+    return ShotMapping(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
+
+
+def material_properties(config: dict) -> MaterialProperties:
+    """`material`, its `eos` sub-section flattened."""
+    material = config["material"]
+    flat = {**{k: v for k, v in material.items() if k != "eos"}, **material["eos"]}
+    return MaterialProperties(**{f.name: float(flat[f.name]) for f in fields(MaterialProperties)})
+
+
+def hydro_settings(config: dict) -> HydroSettings:
+    """`hydro` (its `end_time_us` belongs to the geometry)."""
+    return HydroSettings(**{f.name: float(config["hydro"][f.name]) for f in fields(HydroSettings)})
+
+
+def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
+                 ) -> tuple[Geometry, MaterialProperties, HydroSettings]:
+    """`run_shot`'s inputs for a shot besides its parameters: (Geometry, MaterialProperties,
+    HydroSettings). `spec` is the shot's config section (`shot_config(config, shot)`); `end_us` (us)
+    defaults to the config's end time (`end_time_us`)."""
+    end_us = end_time_us(config, spec) if end_us is None else end_us
+    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us)),
+            material_properties(config), hydro_settings(config))
+
+
+def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
+    """`shots.<shot>.analysis` and `features`."""
+    from shockcal.features import ExtractorSettings
+
+    return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
+
+
+def emulator_settings(config: dict) -> EmulatorSettings:
+    """`emulator` (the GP settings by name), seeded by study.seed."""
+    from shockcal.pcgp import Settings as EmulatorSettings
+
+    section = config["emulator"]
+    names = {f.name for f in fields(EmulatorSettings)} - {"seed"}
+    return EmulatorSettings(seed=config["study"]["seed"], **{k: section[k] for k in names if k in section})
+
+
+def emulator_spec(config: dict, shots) -> EmulatorSpec:
+    """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots`."""
+    from shockcal.emulator import POWER_INPUTS, EmulatorSpec
+
+    section = config["emulator"]
+    powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key])
+    return EmulatorSpec(section["structure"], {s: shot_mapping(config, s) for s in shots}, prior_bounds(config),
+                        powers, emulator_settings(config))
+
+
+def calibration_settings(config: dict, shots, check: bool = False) -> CalibrationSettings:
+    """`calibration` (with `check`, the synthetic-truth trials' `calibration.check`, whose draws are its
+    n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units` and the
+    inputs' units, seeded by the shots' "calibration" stream of study.seed (a trial reseeds from its own)."""
+    from shockcal.calibration import CalibrationSettings
+    from shockcal.sampler import SamplerSettings
+
+    section = config["calibration"]["check"] if check else config["calibration"]
+    draws = section["n_eff"] if check else section["draws"]
+    seed = stream_seed(config["study"]["seed"], "calibration", *shots)
+    sampler = SamplerSettings(n_live=section["n_live"], n_eff=section["n_eff"], draws=draws, seed=seed,
+                              cube_power=config["calibration"]["cube_power"],
+                              max_evaluations=config["calibration"]["max_evaluations"])
+    return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
+                               {name: box["unit"] for name, box in config["inputs"].items()})
+
+
+def load_study_design(path, config: dict, columns: list[str] | None = None) -> pd.DataFrame:
+    """`load_design` against the config's prior box (`input_box`)."""
+    return load_design(path, input_box(config), columns)
+
+
+def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
+                 lhs: bool = False) -> tuple[pd.DataFrame, str]:
+    """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
+    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box, seeded from
+    `stream` of study.seed (`shockcal.seeds`) unless `seed` is given."""
+    if not lhs and config["design"]["file"]:
+        design = load_study_design(config["design"]["file"], config)
+        return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
+    seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
+    return latin_hypercube(prior_bounds(config), n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
+
+
+def observed_table(config: dict) -> pd.DataFrame:
+    """The measured features of every shot (one row per shot: shot, source, the ten features), from
+    the VISAR records through the extractor (`observed.source: records`) or the published values."""
+    import pandas as pd
+
+    from shockcal.features import COLUMNS, record_features
+
+    observed = config["observed"]
+    rows = []
+    for shot in config["shots"]:      # the config's validation checked that every shot has its source's entry
+        if observed["source"] == "records":
+            spec = observed["records"][shot]
+            rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
+                         **record_features(spec["path"], extractor_settings(config, shot), shot,
+                                           spec["time_column"], spec["velocity_column"])})
+        else:
+            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
+                         **observed["features"][shot]})
+    return pd.DataFrame(rows)[["shot", "source", *COLUMNS]]

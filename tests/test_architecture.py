@@ -1,0 +1,58 @@
+"""The house rules of the package layout (docs/architecture.md), checked on the source's imports:
+the library never reads the study config, the hydrocode is the ground floor, and no two modules
+import each other, directly or around a circle."""
+
+from __future__ import annotations
+
+import ast
+import graphlib
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "src" / "shockcal"
+# the rooms that read the study config: the commands, the study package, the figure registry
+CONFIG_READERS = ("shockcal.cli", "shockcal.study", "shockcal.plots.catalogue")
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports() -> dict[str, set[str]]:
+    """Every shockcal module and the shockcal modules it imports (at the top or inside a function)."""
+    modules = {_module_name(path): path for path in PACKAGE.rglob("*.py")}
+    graph = {}
+    for name, path in modules.items():
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("shockcal"):
+                found.add(node.module)
+                found.update(f"{node.module}.{alias.name}" for alias in node.names
+                             if f"{node.module}.{alias.name}" in modules)
+            elif isinstance(node, ast.Import):
+                found.update(alias.name for alias in node.names if alias.name.startswith("shockcal"))
+        graph[name] = {m for m in found if m in modules and m != name}
+    return graph
+
+
+def _is_in(module: str, rooms) -> bool:
+    return any(module == room or module.startswith(room + ".") for room in rooms)
+
+
+def test_no_library_module_reads_the_study_config():
+    offenders = {m: sorted(i for i in imported if _is_in(i, ("shockcal.study",)))
+                 for m, imported in _imports().items() if not _is_in(m, CONFIG_READERS)}
+    assert not {m: i for m, i in offenders.items() if i}, "library modules importing shockcal.study"
+
+
+def test_the_hydrocode_imports_nothing_of_the_study():
+    for module, imported in _imports().items():
+        if _is_in(module, ("shockcal.hydro",)):
+            outside = sorted(i for i in imported if not _is_in(i, ("shockcal.hydro", "shockcal.units")))
+            assert not outside, f"{module} imports {outside}: the hydrocode is the ground floor"
+
+
+def test_no_import_circles():
+    # the package's own __init__ (lazy notebook API) and the cli's registry are entry points, not rooms
+    graph = {m: {i for i in imported if i not in ("shockcal", "shockcal.cli")} for m, imported in _imports().items()}
+    graphlib.TopologicalSorter(graph).prepare()      # raises CycleError naming the circle
