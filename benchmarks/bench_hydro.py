@@ -18,20 +18,17 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 os.environ.setdefault("NUMBA_CACHE_DIR", tempfile.mkdtemp(prefix="shockcal-bench-numba-"))
 
-from shockcal.hydro import (
-    ShotParameters,  # noqa: E402
-    run_shot,  # noqa: E402
-)
+from shockcal.hydro import ShotParameters, run_shot  # noqa: E402
 from shockcal.study.adapters import hydro_inputs  # noqa: E402
-from shockcal.study.config import end_time_us, shot_config
+from shockcal.study.config import end_time_us, shot_config  # noqa: E402
 from shockcal.study.validate import load_config  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
-GRAY = dict(A=0.0017, B=0.00425, C=0.0335, n=0.42, m=1.225)
+GRAY = dict(A_Mbar=0.0017, B_Mbar=0.00425, C=0.0335, n=0.42, m=1.225)
 NOMINAL_V = {"104S": 0.0204, "105S": 0.03549, "106S": 0.04838}
 REPEATS = 2
 TABLE_I = {  # sigma_HEL GPa, u_e km/s, U_s km/s, sigma_final GPa, u_p km/s, rho final g/cc (SPEC section 1)

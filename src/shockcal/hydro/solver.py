@@ -24,7 +24,7 @@ rear node nf and the target's front node nf+1. Both outer nodes are free surface
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
    only), elastic trial deviator and Johnson-Cook radial return (skipped while the trial lies inside
-   the cell's flow-stress floor: `floor_at`, `set_floor`), energy equation, EOS;
+   the cell's flow-stress floor: `floor_at`, `new_floors`), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
@@ -247,23 +247,22 @@ def johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material):
 
 
 @njit(cache=True, error_model="numpy")
-def floor_at(j, T_cell, flow_floor, floor_hotter, floor_T):
-    """Cell j's flow-stress floor at temperature T_cell (K): the floor set at floor_T[j] while the cell
-    is no hotter, the hotter one up to FLOOR_MARGIN_K above it, else -1 (none holds)."""
-    if T_cell <= floor_T[j]:
-        return flow_floor[j]
-    if T_cell <= floor_T[j] + FLOOR_MARGIN_K:
-        return floor_hotter[j]
+def floor_at(T_cell, flow_floor, floor_hotter, floor_T):
+    """A cell's flow-stress floor (Mbar) at temperature T_cell (K), from its cached floors: the one set at
+    floor_T (K) while the cell is no hotter, the hotter one up to FLOOR_MARGIN_K above it, else -1 (none)."""
+    if T_cell <= floor_T:
+        return flow_floor
+    if T_cell <= floor_T + FLOOR_MARGIN_K:
+        return floor_hotter
     return -1.0
 
 
 @njit(cache=True, error_model="numpy")
-def set_floor(j, T_cell, hard, thermal, thermal_hotter, flow_floor, floor_hotter, floor_T):
-    """After a full evaluation of cell j's flow stress at T_cell (K): its floors (A + B eps_p^n) times the
-    thermal factor at T_cell and its bound FLOOR_MARGIN_K hotter, each just below by FLOOR_SLACK."""
-    floor_T[j] = T_cell
-    flow_floor[j] = FLOOR_SLACK * hard * thermal
-    floor_hotter[j] = FLOOR_SLACK * hard * thermal_hotter
+def new_floors(hard, thermal, thermal_hotter):
+    """(flow_floor, floor_hotter) after a full evaluation of the flow stress: A + B eps_p^n (Mbar) times
+    the thermal factor at the cell's temperature and its bound FLOOR_MARGIN_K hotter, each just below by
+    FLOOR_SLACK."""
+    return FLOOR_SLACK * hard * thermal, FLOOR_SLACK * hard * thermal_hotter
 
 
 @njit(cache=True, error_model="numpy")
@@ -316,7 +315,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
         T_cell = material.T_ref + E[j] / material.cv
-        floor = floor_at(j, T_cell, flow_floor, floor_hotter, floor_T)
+        floor = floor_at(T_cell, flow_floor[j], floor_hotter[j], floor_T[j])
         if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
             s_new, d_eps = s_trial, 0.0
         else:
@@ -325,7 +324,8 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
             if d_eps > 0.0:
                 eps_p[j] += d_eps
                 hard[j] = hardening(strength.A, strength.B, strength.n, eps_p[j])
-            set_floor(j, T_cell, hard[j], thermal, thermal_hotter, flow_floor, floor_hotter, floor_T)
+            floor_T[j] = T_cell
+            flow_floor[j], floor_hotter[j] = new_floors(hard[j], thermal, thermal_hotter)
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)
