@@ -28,13 +28,15 @@ REPO = Path(__file__).resolve().parents[1]
 CONFIG = REPO / "config" / "config.yaml"
 
 
-def features(out: str, runs: int, perturb: float) -> None:
+def features(out: str, runs: int, perturb: float, config_path: Path, cfl: float | None) -> None:
     from shockcal.features import features_table
     from shockcal.simulate import simulate_design
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping, study_design
     from shockcal.study.validate import load_config
 
-    config = load_config(CONFIG)
+    config = load_config(config_path)
+    if cfl is not None:
+        config["hydro"]["cfl"] = cfl
     design, _ = study_design(config, lhs=True)
     design = design.iloc[:runs].copy()
     names = [c for c in design.columns if c != "run"]
@@ -79,13 +81,15 @@ def main() -> None:
     f.add_argument("--out", required=True)
     f.add_argument("--runs", type=int, default=30)
     f.add_argument("--perturb", type=float, default=0.0)
+    f.add_argument("--config", type=Path, default=CONFIG, help="study config (default config/config.yaml)")
+    f.add_argument("--cfl", type=float, help="override hydro.cfl")
     c = sub.add_parser("compare")
     c.add_argument("reference")
     c.add_argument("candidate")
     c.add_argument("floor")
     args = parser.parse_args()
     if args.command == "features":
-        features(args.out, args.runs, args.perturb)
+        features(args.out, args.runs, args.perturb, args.config, args.cfl)
     else:
         compare(args.reference, args.candidate, args.floor)
 

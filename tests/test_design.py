@@ -86,3 +86,59 @@ def test_write_design_rewrites_only_changed_rows(paper_config, tmp_path):
     grown = pd.concat([design, latin_hypercube(prior_bounds(paper_config), 1, seed=2).assign(run=6)], ignore_index=True)
     assert write_design(grown, "file saved.csv", input_box(paper_config), path)
     assert pd.read_parquet(path).equals(grown[["run", *design.columns[1:]]])
+
+
+def _with_fourth_shot(config, base_shots):
+    """The study with a shot 107S that brings its own impact velocity V4 and modulus increment Delta4."""
+    config["design"]["base_shots"] = base_shots
+    config["inputs"]["V4"] = dict(config["inputs"]["V3"])
+    config["inputs"]["Delta4"] = dict(config["inputs"]["Delta3"])
+    config["shots"]["107S"] = dict(config["shots"]["106S"], velocity_input="V4",
+                                   shear_modulus_inputs=["G1", "Delta2", "Delta4"])
+    return config
+
+
+def test_the_study_design_is_the_hypercube_over_the_base_shots_inputs(paper_config):
+    from shockcal.study.adapters import study_design
+
+    design, _ = study_design(paper_config, n_runs=40)
+    pd.testing.assert_frame_equal(design, latin_hypercube(prior_bounds(paper_config), 40, paper_config["study"]["seed"]))
+
+
+def test_an_added_shot_draws_its_own_inputs_and_leaves_every_column_alone(paper_config):
+    from shockcal.study.adapters import study_design
+
+    before, _ = study_design(paper_config, n_runs=40)
+    after, source = study_design(_with_fourth_shot(paper_config, ["104S", "105S", "106S"]), n_runs=40)
+    pd.testing.assert_frame_equal(after[before.columns], before)
+    assert list(after.columns) == [*before.columns, "V4", "Delta4"] and "drawn for shot(s) 107S" in source
+    for name in ("V4", "Delta4"):                       # a one-dimensional Latin hypercube: one point per stratum
+        box = paper_config["inputs"][name]
+        strata = np.floor((after[name] - box["min"]) / (box["max"] - box["min"]) * 40).astype(int)
+        assert sorted(strata) == list(range(40)), name
+    assert abs(np.corrcoef(after["V4"], after["Delta4"])[0, 1]) < 0.5          # own seeds: not the same permutation
+    again, _ = study_design(paper_config, n_runs=40)
+    pd.testing.assert_frame_equal(again, after)                                   # seeded by the shot and input
+
+
+def test_a_design_file_keeps_its_columns_and_gets_the_added_shots_missing_ones(paper_config, tmp_path):
+    from shockcal.study.adapters import study_design
+
+    base = latin_hypercube(prior_bounds(paper_config), 12, seed=5)
+    config = _with_fourth_shot(paper_config, ["104S", "105S", "106S"])
+    base.to_csv(tmp_path / "d.csv", index=False)
+    config["design"]["file"] = str(tmp_path / "d.csv")
+    drawn, _ = study_design(config)
+    pd.testing.assert_frame_equal(drawn[base.columns], base)
+    base.assign(V4=0.05, Delta4=0.1).to_csv(tmp_path / "d.csv", index=False)
+    given, _ = study_design(config)
+    assert (given["V4"] == 0.05).all() and (given["Delta4"] == 0.1).all()
+
+
+def test_base_shots_must_name_shots(paper_config):
+    from shockcal.errors import ConfigError
+    from shockcal.study.validate import validate_config
+
+    paper_config["design"]["base_shots"] = ["104S", "108S"]
+    with pytest.raises(ConfigError, match=r"design\.base_shots: '108S' is not a shot"):
+        validate_config(paper_config)

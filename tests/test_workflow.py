@@ -225,6 +225,18 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
     assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
 
 
+def test_a_shot_added_by_config_alone_runs_only_its_simulations(study, tmp_path):
+    """Adding a shot is a config edit: its own impact velocity and modulus increment under `inputs`,
+    the shot and its record. The design grows by itself (`design.base_shots`): only its chunks run."""
+    results, config = study
+    quick = load_config(REPO / "config" / "config.yaml")
+    shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4", shear_modulus_inputs=["G1", "Delta4"])
+    more = overlay(tmp_path / "shot.yaml", inputs={"V4": quick["inputs"]["V3"], "Delta4": quick["inputs"]["Delta3"]},
+                   shots={"107S": shot}, observed={"records": {"107S": dict(quick["observed"]["records"]["106S"])}})
+    jobs = pending_jobs(config, more)
+    assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
+
+
 def test_bad_config_is_rejected_before_any_job(tmp_path):
     bad = overlay(tmp_path / "bad.yaml", simulate={"chunk_size": 0})
     done = snakemake("all", "--dry-run", config_files=[bad], check=False)

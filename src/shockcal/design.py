@@ -69,6 +69,25 @@ def latin_hypercube(bounds: Mapping[str, tuple[float, float]], n_runs: int, seed
     return design
 
 
+def extend_design(design: pd.DataFrame, bounds: Mapping[str, tuple[float, float]], seeds: Mapping[str, int]
+                  ) -> pd.DataFrame:
+    """The design with one new column per input of `bounds`, each a one-dimensional Latin hypercube
+    over the design's rows (scipy.stats.qmc) from its own seed; the existing columns are untouched.
+
+    Args:
+        design: design table (`run` and its inputs).
+        bounds: new input name -> (min, max), native units.
+        seeds: new input name -> the seed of its column.
+    """
+    from scipy.stats import qmc
+
+    extended = design.copy()
+    for name, (low, high) in bounds.items():
+        unit = qmc.LatinHypercube(d=1, seed=np.random.default_rng(seeds[name])).random(len(design))[:, 0]
+        extended[name] = low + unit * (high - low)
+    return extended
+
+
 def load_design(path: str | Path, box: InputBox, columns: list[str] | None = None) -> pd.DataFrame:
     """Read a CSV/Parquet design, check it, and return it with an integer `run` column.
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import TYPE_CHECKING
 
-from shockcal.design import InputBox, ShotMapping, latin_hypercube, load_design
+from shockcal.design import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.seeds import stream_seed
 from shockcal.study.config import end_time_us, prior_bounds, shot_config
@@ -109,16 +109,58 @@ def load_study_design(path, config: dict, columns: list[str] | None = None) -> p
     return load_design(path, input_box(config), columns)
 
 
+def base_inputs(config: dict) -> list[str]:
+    """The inputs the design's Latin hypercube spans, in config order: those of `design.base_shots`
+    (every shot when null). An input only a later shot reads gets a column of its own (`study_design`)."""
+    base_shots = config["design"]["base_shots"] or list(config["shots"])
+    used = {name for shot in base_shots for name in shot_mapping(config, shot).inputs()}
+    return [name for name in config["inputs"] if name in used]
+
+
+def extension_inputs(config: dict) -> dict[str, str]:
+    """Input -> the first shot (config order) outside `design.base_shots` that reads it, for the inputs
+    the base shots do not read: each gets its own column, seeded by that shot and its name."""
+    base = set(base_inputs(config))
+    owner: dict[str, str] = {}
+    for shot in config["shots"]:
+        for name in shot_mapping(config, shot).inputs():
+            if name not in base:
+                owner.setdefault(name, shot)
+    return {name: owner[name] for name in config["inputs"] if name in owner}
+
+
 def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
                  lhs: bool = False) -> tuple[pd.DataFrame, str]:
     """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
-    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box, seeded from
-    `stream` of study.seed (`shockcal.seeds`) unless `seed` is given."""
+    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box of
+    `base_inputs`, seeded from `stream` of study.seed (`shockcal.seeds`) unless `seed` is given.
+
+    An input that only a shot outside `design.base_shots` reads (a shot added to a study: its own
+    impact velocity or modulus increment), and that the design file does not hold, is drawn as a
+    column of its own for the existing rows (`extend_design`, stream design_extension keyed by the
+    shot and the input): no existing column changes, so no other shot's runs rerun."""
+    from shockcal.io import read_table
+
+    names, extension = list(config["inputs"]), extension_inputs(config)
     if not lhs and config["design"]["file"]:
-        design = load_study_design(config["design"]["file"], config)
-        return design if n_runs is None else design.iloc[:n_runs], f"file {config['design']['file']}"
-    seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
-    return latin_hypercube(prior_bounds(config), n_runs or config["design"]["n_runs"], seed), f"Latin hypercube, seed {seed}"
+        path = config["design"]["file"]
+        given = set(read_table(path).columns)
+        design = load_study_design(path, config, [n for n in names if n not in extension or n in given])
+        design, source = (design if n_runs is None else design.iloc[:n_runs]), f"file {path}"
+    else:
+        seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
+        bounds = prior_bounds(config)
+        design = latin_hypercube({n: bounds[n] for n in names if n not in extension}, n_runs or config["design"]["n_runs"],
+                                 seed)
+        source = f"Latin hypercube, seed {seed}"
+    missing = {n: shot for n, shot in extension.items() if n not in design.columns}
+    if missing:
+        bounds = prior_bounds(config)
+        design = extend_design(design, {n: bounds[n] for n in missing},
+                               {n: stream_seed(config["study"]["seed"], "design_extension", shot, n)
+                                for n, shot in missing.items()})
+        source += f"; {', '.join(missing)} drawn for shot(s) {', '.join(dict.fromkeys(missing.values()))}"
+    return design[["run", *names]], source
 
 
 def observed_table(config: dict) -> pd.DataFrame:

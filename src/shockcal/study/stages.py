@@ -26,7 +26,7 @@ _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
-    "design": ("study.seed", "design", "inputs", "checks.design_box", "shots.*.velocity_input"),
+    "design": ("study.seed", "design", "inputs", "checks.design_box", *_SHOT_MAPPING),
     # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
     "check_design": ("study.seed", "inputs", "calibration.check.trials"),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto

@@ -85,6 +85,9 @@ def _normalise_shot_names(config: dict) -> None:
         if isinstance(section, dict):
             for key in [k for k in section if not isinstance(k, str)]:
                 section[str(key)] = section.pop(key)
+    base_shots = (config.get("design") or {}).get("base_shots")
+    if isinstance(base_shots, list):
+        config["design"]["base_shots"] = [str(shot) for shot in base_shots]
 
 
 def _schema_message(exc) -> str:
@@ -114,6 +117,9 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for name in config["calibration"]["cube_power"]:
         if name not in inputs:
             raise ConfigError(f"{source}: calibration.cube_power.{name}: not one of the inputs {sorted(inputs)}")
+    for shot in config["design"]["base_shots"] or []:
+        if shot not in config["shots"]:
+            raise ConfigError(f"{source}: design.base_shots: '{shot}' is not a shot; known shots are {sorted(config['shots'])}")
     design_file = config["design"].get("file")
     if design_file and not Path(design_file).is_file():
         raise ConfigError(f"{source}: design.file: {design_file} does not exist")
