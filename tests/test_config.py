@@ -73,9 +73,11 @@ def test_unquoted_shot_names_become_strings(tmp_path, paper_config):
     paper_config["shots"] = {104: shots["104S"]}
     paper_config["observed"]["features"] = {}
     paper_config["observed"]["records"] = {104: paper_config["observed"]["records"]["104S"]}
+    paper_config["design"]["base_shots"] = [104]
     validate_config(paper_config)
     assert list(paper_config["shots"]) == ["104"]
     assert list(paper_config["observed"]["records"]) == ["104"]
+    assert paper_config["design"]["base_shots"] == ["104"]
 
 
 @pytest.mark.parametrize("source, section", [("records", "records"), ("published", "features")])
