@@ -18,12 +18,16 @@ them (figures, posterior-predictive runs), and summaries use the weights.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
+from shockcal.progress import Every
+
+log = logging.getLogger("shockcal.sampler")
 
 
 @dataclass
@@ -71,6 +75,11 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     of a coordinate in the cube: a thin posterior arm there (m near 0, docs/calibration.md "The
     low-m arm") gets as many live points as its mass needs instead of being cut off by the bounds.
     The draws' `log_likelihood` is the caller's, without the ratio.
+
+    Progress goes to the log (logger `shockcal.sampler`, INFO) at most every 30 s: evaluations spent,
+    then the effective sample size against `n_eff`. nautilus's own `verbose` status is not used: it
+    redraws one line with carriage returns, padded to the terminal's width, which a job's log file
+    keeps as one long line.
     """
     from nautilus import Sampler
 
@@ -83,7 +92,12 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     def to_parameters(u):
         return prior_transform(u ** power)
 
+    every = Every()
+
     def sampled_log_likelihood(u):
+        if every():    # reads the sampler's counters only: the draws do not change
+            log.info("nautilus: %s likelihood evaluations in %.0f s, %s", f"{sampler.n_like:,}", every.elapsed_s(),
+                     f"effective sample size {sampler.n_eff:.0f} of {n_eff}" if sampler.explored else "exploring")
         return log_likelihood(to_parameters(u)) + log_density_ratio(u)
 
     sampler = Sampler(lambda u: u, sampled_log_likelihood, n_dim=ndim, n_live=n_live, vectorized=True, seed=seed,

@@ -17,6 +17,7 @@ import pandas as pd
 from shockcal.config import end_time_us
 from shockcal.design import ShotMapping
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
+from shockcal.progress import progress
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.simulate")
@@ -38,10 +39,11 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None):
 def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geometry, material: MaterialProperties,
                     settings: HydroSettings) -> pd.DataFrame:
     """Simulate every row of `design` (Table IV units) for the shot `mapping` reads it as, to
-    `geometry.end_us`; failures become rows with a reason. From a config: `ShotMapping.from_config` and `hydro_inputs`."""
+    `geometry.end_us`; failures become rows with a reason. From a config: `ShotMapping.from_config` and `hydro_inputs`.
+    Runs done and time left go to stderr (`shockcal.progress`: a bar on a terminal, a log line every 30 s otherwise)."""
     shot, inputs = mapping.shot, mapping.inputs()
     rows = []
-    for record in design.to_dict("records"):
+    for record in progress(design.to_dict("records"), len(design), f"shot {shot}", "run", log):
         params = mapping.parameters(record)
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
                "impact_velocity_m_s": params.velocity_cm_us * CM_US_TO_M_S,
