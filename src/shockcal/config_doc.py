@@ -47,9 +47,9 @@ JSON Schema that the Snakefile and every `shockcal` command validate a config ag
   reruns when") include the key, so a change reruns their jobs through the rules' params; "(its shot)"
   means only the jobs of the shot whose key changed, "(shots that read it)" those of the shots whose
   `velocity_input` or `shear_modulus_inputs` name the input. `figures 9, 10` are the figures (the
-  paper's numbers) whose catalogue entry reads the key (`FigureSpec.reads`). Snakemake then reruns whatever reads a rerun
-  job's changed outputs. *none declared*: no stage lists the key; its meaning says what the workflow
-  does with it.
+  paper's numbers) whose catalogue entry reads the key (`FigureSpec.reads`). Snakemake then reruns
+  whatever reads a rerun job's changed outputs. *none declared*: no stage lists the key; its meaning
+  says what the workflow does with it.
 """
 
 
