@@ -14,6 +14,7 @@ from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.errors import InputError, ShockcalError
 from shockcal.features import CALIBRATION_FEATURES
 from shockcal.problem import LAMBDA_Y_PRIOR, Problem, log_density
+from shockcal.progress import progress
 
 log = logging.getLogger("shockcal.calibration")
 
@@ -42,7 +43,8 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
                          f"but only {len(hydro_draws)} truth runs are usable")
     rows = []
-    for done, trial in enumerate(trial_ids, 1):
+    batch = progress(trial_ids, len(trial_ids), f"synthetic trials {'+'.join(shots)}", "trial", log)
+    for done, trial in enumerate(batch, 1):
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
         try:
             rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws)
@@ -50,7 +52,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
             log.warning("synthetic trial %d failed: %s", trial, error)
             rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
                      for name in [*names, "lambda_y"]]
-        log.info("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))
+        log.debug("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))   # progress: count, time left
     table = pd.DataFrame(rows, columns=CHECK_COLUMNS)
     table["inside"] = table["inside"].astype("boolean")
     return table

@@ -1,9 +1,10 @@
 """Tables on disk: Parquet (pyarrow) for everything shockcal writes, CSV accepted wherever a table is read.
 
 Each table shockcal writes carries a JSON document under the Parquet schema-metadata key
-``shockcal`` (units of its columns, the producing command, its version): read it with
-`read_table_metadata`. Writes go to a temporary file renamed into place, so an interrupted job never
-leaves a half-written table that a rerun would mistake for a finished one.
+``shockcal`` (units of its columns, the producing command, and under ``provenance`` the shockcal
+version and git commit that wrote it: `shockcal.provenance`): read it with `read_table_metadata`.
+Writes go to a temporary file renamed into place, so an interrupted job never leaves a half-written
+table that a rerun would mistake for a finished one.
 """
 
 from __future__ import annotations
@@ -54,17 +55,19 @@ def read_tables(paths, keys: list[str], what: str) -> pd.DataFrame:
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict | None = None) -> Path:
-    """Write `df` as Parquet atomically, with `metadata` (JSON-serialisable) in the schema."""
+    """Write `df` as Parquet atomically, with `metadata` (JSON-serialisable) in the schema and this
+    process's `provenance()` under its key ``provenance`` (the same for every run of one checkout)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
+
+    from shockcal.provenance import provenance
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     table = pa.Table.from_pandas(df, preserve_index=False)
-    if metadata is not None:
-        merged = dict(table.schema.metadata or {})
-        merged[METADATA_KEY] = json.dumps(metadata, sort_keys=True).encode()
-        table = table.replace_schema_metadata(merged)
+    merged = dict(table.schema.metadata or {})
+    merged[METADATA_KEY] = json.dumps({**(metadata or {}), "provenance": provenance()}, sort_keys=True).encode()
+    table = table.replace_schema_metadata(merged)
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
     return path

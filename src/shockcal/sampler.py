@@ -19,6 +19,7 @@ returns a `Posterior`, which keeps both, the evidence and the sampler's counts.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -27,7 +28,10 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
+from shockcal.progress import Every
 from shockcal.summaries import summarize
+
+log = logging.getLogger("shockcal.sampler")
 
 
 @dataclass
@@ -75,6 +79,11 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     of a coordinate in the cube: a thin posterior arm there (m near 0, docs/calibration.md "The
     low-m arm") gets as many live points as its mass needs instead of being cut off by the bounds.
     The draws' `log_likelihood` is the caller's, without the ratio.
+
+    Progress goes to the log (logger `shockcal.sampler`, INFO) at most every 30 s: evaluations spent,
+    then the effective sample size against `n_eff`. nautilus's own `verbose` status is not used: it
+    redraws one line with carriage returns, padded to the terminal's width, which a job's log file
+    keeps as one long line.
     """
     from nautilus import Sampler
 
@@ -87,7 +96,12 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     def to_parameters(u):
         return prior_transform(u ** power)
 
+    every = Every()
+
     def sampled_log_likelihood(u):
+        if every():    # reads the sampler's counters only: the draws do not change
+            log.info("nautilus: %s likelihood evaluations in %.0f s, %s", f"{sampler.n_like:,}", every.elapsed_s(),
+                     f"effective sample size {sampler.n_eff:.0f} of {n_eff}" if sampler.explored else "exploring")
         return log_likelihood(to_parameters(u)) + log_density_ratio(u)
 
     sampler = Sampler(lambda u: u, sampled_log_likelihood, n_dim=ndim, n_live=n_live, vectorized=True, seed=seed,

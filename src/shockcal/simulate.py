@@ -16,6 +16,7 @@ import pandas as pd
 
 from shockcal.design import ShotMapping
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
+from shockcal.progress import progress
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.simulate")
@@ -37,11 +38,12 @@ def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geomet
         material: EOS and thermal constants (user units).
         settings: the hydrocode's numerics.
 
-    From a study config: `shockcal.study.adapters.shot_mapping` and `hydro_inputs`.
+    From a study config: `shockcal.study.adapters.shot_mapping` and `hydro_inputs`. Runs done and
+    time left go to stderr (`shockcal.progress`: a bar on a terminal, a log line every 30 s otherwise).
     """
     shot, inputs = mapping.shot, mapping.inputs()
     rows = []
-    for record in design.to_dict("records"):
+    for record in progress(design.to_dict("records"), len(design), f"shot {shot}", "run", log):
         params = mapping.parameters(record)
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
                "impact_velocity_m_s": params.table_iv().velocity_cm_us * CM_US_TO_M_S,

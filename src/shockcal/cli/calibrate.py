@@ -85,6 +85,8 @@ def run(args) -> int:
 
 
 def run_check(args) -> int:
+    import logging
+
     from shockcal.coverage import coverage_table, synthetic_truth
     from shockcal.emulator import Emulator
     from shockcal.io import write_table
@@ -93,6 +95,8 @@ def run_check(args) -> int:
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate_check")
+    if not getattr(args, "verbose", False):   # the batch's progress line (count, time left) says enough; each trial's sampler lines: -v
+        logging.getLogger("shockcal.sampler").setLevel(logging.WARNING)
     truths = hydro_truths(args)
     truth = "emulator" if truths is None else "hydrocode"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
