@@ -131,6 +131,13 @@ class Emulator:
         self.shots = [s for b in blocks for s in b.shots]
         self._bounds = bounds            # design input -> (min, max), native units
         self._shot_inputs = shot_inputs  # shot -> design inputs it depends on (SPEC section 3)
+        for block in blocks:             # the array emulator's inputs by name: the map's, then base^column
+            block.model._input_names = [*block.input_map.names, *(f"{base:g}^{column}" for base, column in block.input_map.powers)]
+
+    def __repr__(self) -> str:
+        blocks = "; ".join(f"{'+'.join(b.shots)}: {len(b.runs)} runs, inputs {b.model.input_names}, "
+                           f"{len(b.model.gps)} components" for b in self.blocks)
+        return f"Emulator({self.structure}, shots {self.shots}, features {self.feature_names}; {blocks})"
 
     def required_inputs(self, shots) -> list[str]:
         """Design inputs a calibration of `shots` needs, in the box's order."""

@@ -7,7 +7,7 @@ These are what `run_shot` takes; each converts itself to the kernel's named tupl
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from shockcal.hydro.solver import Material, Numerics
 from shockcal.units import J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
@@ -52,11 +52,6 @@ class MaterialProperties:
     cv_J_per_kg_K: float
     strain_rate_ref_per_s: float = 1.0
 
-    @classmethod
-    def from_config(cls, material: dict) -> MaterialProperties:
-        """From a validated config's `material` section (its `eos` sub-section flattened)."""
-        flat = {**{k: v for k, v in material.items() if k != "eos"}, **material["eos"]}
-        return cls(**{f.name: float(flat[f.name]) for f in fields(cls)})
 
     def code_units(self) -> Material:
         return Material(self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0, self.T_ref_K,
@@ -93,10 +88,6 @@ class HydroSettings:
     q_linear: float = 0.1
     q_quadratic: float = 1.0
 
-    @classmethod
-    def from_config(cls, hydro: dict) -> HydroSettings:
-        """From a validated config's `hydro` section (its `end_time_us` belongs to the geometry)."""
-        return cls(**{f.name: float(hydro[f.name]) for f in fields(cls)})
 
     def numerics(self) -> Numerics:
         return Numerics(self.q_linear, self.q_quadratic, self.cfl, self.dt_initial_us, self.dt_max_us)

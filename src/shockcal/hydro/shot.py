@@ -37,6 +37,13 @@ class RunResult:
     wall_time_s: float = 0.0
     energy_history: np.ndarray = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        peak = f"{np.max(self.v_m_s):.1f} m/s" if len(self.v_m_s) else "no trace"
+        end = f"{self.t_us[-1]:.3f} us" if len(self.t_us) else "-"
+        why = f" ({self.reason})" if self.reason else ""
+        return (f"RunResult({self.status}{why}: {len(self.t_us)} points to {end}, peak free-surface velocity {peak}, "
+                f"{self.n_steps} steps in {self.wall_time_s:.3f} s, energy error {self.energy_error:.1e})")
+
 
 STUDY_NUMERICS = HydroSettings()
 
