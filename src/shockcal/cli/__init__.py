@@ -26,6 +26,7 @@ STAGE_MODULES = [
     "shockcal.cli.predict",
     "shockcal.cli.figures",
     "shockcal.cli.stage_times",
+    "shockcal.cli.flow_stress",
 ]
 
 
