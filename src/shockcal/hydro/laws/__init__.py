@@ -11,7 +11,7 @@ ignores what it does not depend on. Laws whose shear modulus varies also have
 bit), `steinberg-guinan`, `ptw` (Preston-Tonks-Wallace) and `zerilli-armstrong` (fcc). Their
 parameters, in user units with the conversion to code units, are declared in `declarations.py`;
 prior boxes for aluminium with sources in config/models.yaml (`boxes.py`). Not yet wired into the
-hydrocode: see docs/hydro.md and the issue.
+hydrocode: docs/strength_laws.md lists the solver's hook points.
 """
 
 from __future__ import annotations
