@@ -27,6 +27,7 @@ STAGE_MODULES = [
     "shockcal.cli.figures",
     "shockcal.cli.stage_times",
     "shockcal.cli.config_doc",
+    "shockcal.cli.flow_stress",
 ]
 
 

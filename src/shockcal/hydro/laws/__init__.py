@@ -1,0 +1,83 @@
+"""Strength laws as small numba kernels behind one interface (issue 37, first part).
+
+Each law has a named tuple of parameters in code units (Mbar, K, 1/us, g/cc) and a kernel
+
+    flow_stress(law, eps_p, strain_rate, T, P, eta) -> Mbar
+
+with `eps_p` the equivalent plastic strain, `strain_rate` the equivalent strain rate (1/us), `T` the
+temperature (K), `P` the pressure (Mbar, positive in compression) and `eta` = rho / rho0; a law
+ignores what it does not depend on. Laws whose shear modulus varies also have
+`shear_modulus(law, P, T, eta) -> Mbar`. The laws: `johnson-cook` (today's hydrocode law, bit for
+bit), `steinberg-guinan`, `ptw` (Preston-Tonks-Wallace) and `zerilli-armstrong` (fcc). Their
+parameters, in user units with the conversion to code units, are declared in `declarations.py`;
+prior boxes for aluminium with sources in config/models.yaml (`boxes.py`). Not yet wired into the
+hydrocode: docs/strength_laws.md lists the solver's hook points.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from shockcal.errors import InputError
+from shockcal.hydro.laws.declarations import ALIASES, LAWS, Law, Param
+from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
+
+MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
+
+__all__ = ["LAWS", "Law", "Param", "code_parameters", "flow_stress_curve", "get_law", "shear_modulus_gpa"]
+
+
+def get_law(name: str) -> Law:
+    """The law called `name` (or an alias: jc, sg, za, preston-tonks-wallace); InputError if unknown."""
+    key = ALIASES.get(name.lower(), name.lower())
+    if key not in LAWS:
+        raise InputError(f"unknown strength model '{name}' (known: {', '.join(LAWS)})")
+    return LAWS[key]
+
+
+def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
+    """The user's values completed with the declared defaults; InputError naming an unknown or
+    missing parameter, a non-finite value or a violated constraint."""
+    unknown = [k for k in values if k not in law.names()]
+    if unknown:
+        raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
+    merged = {p.name: values.get(p.name, p.default) for p in law.params}
+    missing = [k for k, v in merged.items() if v is None]
+    if missing:
+        raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
+    bad = [k for k, v in merged.items() if not np.isfinite(v)]
+    if bad:
+        raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
+    for text, holds in law.constraints:
+        if not holds(merged):
+            raise InputError(f"{law.name}: parameters violate {text}")
+    return merged
+
+
+def code_parameters(law: Law, values: Mapping[str, float]):
+    """The law's named tuple in code units from user values (names and units of `law.params`)."""
+    merged = user_values(law, values)
+    return law.code_type(**{p.field: float(merged[p.name]) * p.to_code for p in law.params})
+
+
+def flow_stress_curve(law: Law, values: Mapping[str, float], plastic_strains, strain_rate_per_s: float,
+                      temperature_K: float, pressure_GPa: float = 0.0, density_ratio: float = 1.0) -> np.ndarray:
+    """Flow stress (MPa) at each equivalent plastic strain, at a constant equivalent strain rate (1/s),
+    temperature (K), pressure (GPa) and density ratio rho/rho0."""
+    params = code_parameters(law, values)
+    rate = strain_rate_per_s * PER_S_TO_PER_US
+    pressure = pressure_GPa / MBAR_TO_GPA
+    return np.array([law.flow_stress(params, float(e), rate, float(temperature_K), pressure, float(density_ratio))
+                     for e in np.asarray(plastic_strains, dtype=float)]) * MBAR_TO_MPA
+
+
+def shear_modulus_gpa(law: Law, values: Mapping[str, float], temperature_K: float, pressure_GPa: float = 0.0,
+                      density_ratio: float = 1.0) -> float | None:
+    """The law's shear modulus (GPa) at the state, or None for laws without a shear-modulus law."""
+    if law.shear_modulus is None:
+        return None
+    params = code_parameters(law, values)
+    G = law.shear_modulus(params, pressure_GPa / MBAR_TO_GPA, float(temperature_K), float(density_ratio))
+    return G * MBAR_TO_GPA

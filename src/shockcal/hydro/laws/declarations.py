@@ -1,0 +1,166 @@
+"""Every strength law's parameters, declared in one place: name (unit-suffixed, as the user writes it),
+the symbol of the paper and the kernel's field, user unit, factor to code units (Mbar, K, 1/us, g/cc,
+g/mol; `shockcal.units`), default (material constants only; calibrated parameters have none) and meaning.
+
+A user value times `to_code` is the kernel's value. Prior boxes for aluminium, with sources, are in
+config/models.yaml (`shockcal.hydro.laws.boxes`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
+from shockcal.hydro.laws.preston_tonks_wallace import PrestonTonksWallace, ptw_flow_stress, ptw_shear_modulus
+from shockcal.hydro.laws.steinberg_guinan import (
+    SteinbergGuinan,
+    steinberg_guinan_flow_stress,
+    steinberg_guinan_shear_modulus,
+)
+from shockcal.hydro.laws.zerilli_armstrong import ZerilliArmstrong, zerilli_armstrong_flow_stress
+from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
+
+GPA_TO_MBAR = 1.0 / MBAR_TO_GPA
+MPA_TO_MBAR = 1.0e-3 / MBAR_TO_GPA
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a law: `name` as the user gives it (unit-suffixed unless dimensionless),
+    `field` of the kernel's named tuple, `unit` of the user value, `to_code` its factor to code units."""
+
+    name: str
+    field: str
+    unit: str
+    to_code: float
+    meaning: str
+    default: float | None = None
+
+
+def _p(name, field, unit, to_code, meaning, default=None) -> Param:
+    return Param(name, field, unit, to_code, meaning, default)
+
+
+def _mpa(name, field, meaning, default=None) -> Param:
+    return _p(name, field, "MPa", MPA_TO_MBAR, meaning, default)
+
+
+def _gpa(name, field, meaning, default=None) -> Param:
+    return _p(name, field, "GPa", GPA_TO_MBAR, meaning, default)
+
+
+def _one(name, meaning, default=None) -> Param:
+    return _p(name, name, "-", 1.0, meaning, default)
+
+
+@dataclass(frozen=True)
+class Law:
+    """A strength law: its kernels (code units, `flow_stress(law, eps_p, rate, T, P, eta)`; the
+    optional `shear_modulus(law, P, T, eta)`), its parameters and the constraints on their values
+    (text, predicate on the user values)."""
+
+    name: str
+    title: str
+    reference: str
+    params: tuple[Param, ...]
+    code_type: type
+    flow_stress: Callable
+    shear_modulus: Callable | None = None
+    constraints: tuple[tuple[str, Callable[[Mapping[str, float]], bool]], ...] = ()
+
+    def param(self, name: str) -> Param:
+        return next(p for p in self.params if p.name == name)
+
+    def names(self) -> list[str]:
+        return [p.name for p in self.params]
+
+
+JOHNSON_COOK = Law(
+    "johnson-cook", "Johnson-Cook (1983), the hydrocode's law",
+    "Johnson & Cook, Proc. 7th Int. Symp. Ballistics (1983)",
+    (
+        _mpa("A_MPa", "A", "yield stress at eps_p = 0"),
+        _mpa("B_MPa", "B", "hardening modulus"),
+        _one("C", "strain-rate coefficient"),
+        _one("n", "hardening exponent"),
+        _one("m", "thermal-softening exponent"),
+        _p("T_ref_K", "T_ref", "K", 1.0, "reference (room) temperature", 298.0),
+        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature (SPEC default 893 K)", 893.0),
+        _p("rate_ref_per_s", "rate_ref", "1/s", PER_S_TO_PER_US, "reference strain rate", 1.0),
+    ),
+    JohnsonCook, johnson_cook_flow_stress,
+    constraints=(("T_melt_K > T_ref_K", lambda v: v["T_melt_K"] > v["T_ref_K"]),
+                 ("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0)),
+)
+
+STEINBERG_GUINAN = Law(
+    "steinberg-guinan", "Steinberg-Guinan (1980), rate-independent",
+    "Steinberg, Cochran & Guinan, J. Appl. Phys. 51, 1498 (1980)",
+    (
+        _gpa("Y0_GPa", "Y0", "yield stress at eps_p = eps_i, P = 0, T = 300 K"),
+        _gpa("Ymax_GPa", "Ymax", "cap of the work-hardened yield stress"),
+        _one("beta", "hardening coefficient"),
+        _one("n", "hardening exponent"),
+        _one("eps_i", "initial equivalent plastic strain", 0.0),
+        _gpa("G0_GPa", "G0", "shear modulus at P = 0, T = 300 K"),
+        _p("dGdP", "dGdP", "-", 1.0, "G'_P = dG/dP"),
+        _p("dGdT_over_G0_per_K", "dGdT_over_G0", "1/K", 1.0, "G'_T / G0 = (dG/dT) / G0 (negative)"),
+        _p("T_m0_K", "T_m0", "K", 1.0, "melt temperature at eta = 1 (Steinberg 1996, Al alloys)", 1220.0),
+        _one("gamma0", "Grueneisen coefficient of the melt law (Steinberg 1996, Al 6061-T6)", 1.97),
+        _one("a", "first-order volume coefficient of the melt law (Steinberg 1996)", 1.5),
+    ),
+    SteinbergGuinan, steinberg_guinan_flow_stress, steinberg_guinan_shear_modulus,
+    constraints=(("G0_GPa > 0", lambda v: v["G0_GPa"] > 0),
+                 ("Ymax_GPa >= Y0_GPa", lambda v: v["Ymax_GPa"] >= v["Y0_GPa"]),
+                 ("beta >= 0 and eps_i >= 0", lambda v: v["beta"] >= 0 and v["eps_i"] >= 0)),
+)
+
+PRESTON_TONKS_WALLACE = Law(
+    "ptw", "Preston-Tonks-Wallace (2003), G = G0 (1 - alpha T / T_melt)",
+    "Preston, Tonks & Wallace, J. Appl. Phys. 93, 211 (2003)",
+    (
+        _one("theta", "initial hardening rate (over G)"),
+        _one("p", "hardening-law shape"),
+        _one("s0", "saturation stress at 0 K (over G)"),
+        _one("sinf", "saturation stress at high T (over G)"),
+        _one("kappa", "temperature dependence of the thermal branch"),
+        _one("gamma", "strain-rate scale of the thermal branch"),
+        _one("y0", "yield stress at 0 K (over G)"),
+        _one("yinf", "yield stress at high T (over G)"),
+        _one("y1", "overdriven yield coefficient"),
+        _one("y2", "overdriven yield exponent"),
+        _one("beta", "overdriven saturation exponent"),
+        _p("M_g_per_mol", "M", "g/mol", 1.0, "molar mass (Al)", 26.9815),
+        _p("rho0_g_per_cc", "rho0", "g/cc", 1.0, "reference density (SPEC Al-5083)", 2.668),
+        _gpa("G0_GPa", "G0", "shear modulus at 0 K"),
+        _one("alpha", "linear thermal softening of G"),
+        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature (SPEC default 893 K)", 893.0),
+    ),
+    PrestonTonksWallace, ptw_flow_stress, ptw_shear_modulus,
+    constraints=(  # PTW 2003 sec. II (also lanl/impala's PTW_goodparam): yield below saturation, both falling with T
+        ("sinf < s0", lambda v: v["sinf"] < v["s0"]), ("yinf < y0", lambda v: v["yinf"] < v["y0"]),
+        ("y0 < s0", lambda v: v["y0"] < v["s0"]), ("yinf < sinf", lambda v: v["yinf"] < v["sinf"]),
+        ("y1 > s0", lambda v: v["y1"] > v["s0"]), ("y2 > beta", lambda v: v["y2"] > v["beta"]),
+        ("p >= 0, gamma > 0, G0_GPa > 0, M_g_per_mol > 0, rho0_g_per_cc > 0",
+         lambda v: min(v["gamma"], v["G0_GPa"], v["M_g_per_mol"], v["rho0_g_per_cc"]) > 0 and v["p"] >= 0),
+    ),
+)
+
+ZERILLI_ARMSTRONG = Law(
+    "zerilli-armstrong", "Zerilli-Armstrong fcc (1987)", "Zerilli & Armstrong, J. Appl. Phys. 61, 1816 (1987)",
+    (
+        _mpa("C0_MPa", "C0", "athermal plus grain-size stress"),
+        _mpa("C2_MPa", "C2", "hardening amplitude"),
+        _p("C3_per_K", "C3", "1/K", 1.0, "thermal softening"),
+        _p("C4_per_K", "C4", "1/K", 1.0, "thermal rate sensitivity"),
+        _p("rate_ref_per_s", "rate_ref", "1/s", PER_S_TO_PER_US, "reference strain rate (1 /s: the paper's ln(epsdot))",
+           1.0),
+    ),
+    ZerilliArmstrong, zerilli_armstrong_flow_stress,
+    constraints=(("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0),),
+)
+
+LAWS: dict[str, Law] = {law.name: law for law in (JOHNSON_COOK, STEINBERG_GUINAN, PRESTON_TONKS_WALLACE,
+                                                  ZERILLI_ARMSTRONG)}
+ALIASES = {"jc": "johnson-cook", "sg": "steinberg-guinan", "preston-tonks-wallace": "ptw", "za": "zerilli-armstrong"}
