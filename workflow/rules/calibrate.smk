@@ -17,6 +17,7 @@ rule calibrate:
         f"{BENCHMARKS}/calibrate/{{name}}.tsv"
     wildcard_constraints:
         name="|".join(CALIBRATIONS),
+    priority: lambda w: 10 if w.name == "joint" else 0  # the joint posterior first: a new shot's answer
     conda:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
