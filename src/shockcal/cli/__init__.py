@@ -23,6 +23,7 @@ STAGE_MODULES = [
     "shockcal.cli.features",
     "shockcal.cli.emulate",
     "shockcal.cli.calibrate",
+    "shockcal.cli.posterior_netcdf",
     "shockcal.cli.predict",
     "shockcal.cli.figures",
     "shockcal.cli.stage_times",
