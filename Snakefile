@@ -29,6 +29,7 @@ include: "workflow/rules/features.smk"
 include: "workflow/rules/emulator.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/predict.smk"
+include: "workflow/rules/sensitivity.smk"
 include: "workflow/rules/figures.smk"
 
 

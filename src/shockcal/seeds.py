@@ -15,6 +15,7 @@ keyed further (an emulator block index, a calibration's shots).
 | check_design | the Latin hypercube of the hydrocode-truth check runs |
 | posterior_draws | the posterior rows run through the hydrocode for predictions |
 | figures | which training traces the history figures draw |
+| sensitivity | the Sobol sequence's scrambling and the bootstrap of the Sobol indices |
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ import zlib
 
 import numpy as np
 
-STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures")
+STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "sensitivity")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:
