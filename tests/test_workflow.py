@@ -109,7 +109,23 @@ def test_report(study, tmp_path):
     report = tmp_path / "report.html"
     snakemake("all", "--report", str(report), config_files=[config])
     text = report.read_text(errors="replace")
-    assert "fig07_marginals" in text and "fig11_history_104S" in text
+    assert "fig07_marginals" in text and "fig11_history_104S" in text and "sobol_indices" in text
+    for table in ("posterior_summary", "evidence", "cross_validation", "sobol"):    # the tables, shown inline
+        assert f"{table}.html" in text, table
+    assert "Where to look" in text                            # the workflow description (workflow/report/workflow.rst)
+
+
+def test_netcdf_and_sobol_products(study):
+    import arviz as az
+
+    results, _ = study
+    for name in ("104S", "105S", "106S", "joint"):
+        idata = az.from_netcdf(results / "posterior" / f"{name}.nc")
+        assert "lambda_y" in idata.posterior and "log_evidence" in idata.attrs
+    assert "posterior_predictive" in az.from_netcdf(results / "posterior" / "joint.nc").groups()
+    sobol = pd.read_csv(results / "sensitivity" / "sobol.csv")
+    assert list(sobol.columns) == ["domain", "shot", "feature", "input", "S1", "S1_conf", "ST", "ST_conf"]
+    assert set(sobol["domain"]) == {"prior", "posterior_q05_q95"} and sobol["ST"].between(-0.1, 1.2).all()
 
 
 def test_nothing_to_redo(study):

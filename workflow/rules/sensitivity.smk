@@ -8,11 +8,7 @@ rule sensitivity:
         arrays=rules.emulator.output.arrays,
         summary=expand(rules.calibrate.output.summary, name="joint"),
     output:
-        report(
-            f"{RESULTS}/sensitivity/sobol.csv",
-            caption="../report/sobol_table.rst",
-            category="6 sensitivity",
-        ),
+        f"{RESULTS}/sensitivity/sobol.csv",  # in the report as report/sobol.html (report.smk)
     log:
         f"{LOGS}/sensitivity.log",
     benchmark:

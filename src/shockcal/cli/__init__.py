@@ -27,6 +27,7 @@ STAGE_MODULES = [
     "shockcal.cli.predict",
     "shockcal.cli.sensitivity",
     "shockcal.cli.figures",
+    "shockcal.cli.report",
     "shockcal.cli.stage_times",
 ]
 
