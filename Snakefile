@@ -7,6 +7,9 @@ from shockcal.study.validate import validate_or_exit
 configfile: "config/config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 # jsonschema against workflow/schemas/config.schema.yaml (the package's schema; defaults filled in), then
 # the cross-field rules and the design file's contents; a bad config ends snakemake with its message
 # alone, naming the key path: "shockcal: error: config: simulate.chunk_size: 0 is less than ..."
@@ -29,7 +32,9 @@ include: "workflow/rules/features.smk"
 include: "workflow/rules/emulator.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/predict.smk"
+include: "workflow/rules/sensitivity.smk"
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:

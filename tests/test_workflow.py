@@ -80,7 +80,7 @@ def test_every_figure_is_a_real_image(study):
     results, _ = study
     config = load_config(REPO / "config" / "config.yaml")
     names = list(catalogue(config))
-    assert len(names) == 15
+    assert len(names) == 16                                   # the paper's fifteen and the Sobol indices
     for name in names:
         png, pdf = results / "figures" / f"{name}.png", results / "figures" / f"{name}.pdf"
         image = matplotlib.image.imread(png)
@@ -109,7 +109,23 @@ def test_report(study, tmp_path):
     report = tmp_path / "report.html"
     snakemake("all", "--report", str(report), config_files=[config])
     text = report.read_text(errors="replace")
-    assert "fig07_marginals" in text and "fig11_history_104S" in text
+    assert "fig07_marginals" in text and "fig11_history_104S" in text and "sobol_indices" in text
+    for table in ("posterior_summary", "evidence", "cross_validation", "sobol"):    # the tables, shown inline
+        assert f"{table}.html" in text, table
+    assert "Where to look" in text                            # the workflow description (workflow/report/workflow.rst)
+
+
+def test_netcdf_and_sobol_products(study):
+    import arviz as az
+
+    results, _ = study
+    for name in ("104S", "105S", "106S", "joint"):
+        idata = az.from_netcdf(results / "posterior" / f"{name}.nc")
+        assert "lambda_y" in idata.posterior and "log_evidence" in idata.attrs
+    assert "posterior_predictive" in az.from_netcdf(results / "posterior" / "joint.nc").groups()
+    sobol = pd.read_csv(results / "sensitivity" / "sobol.csv")
+    assert list(sobol.columns) == ["domain", "shot", "feature", "input", "S1", "S1_conf", "ST", "ST_conf"]
+    assert set(sobol["domain"]) == {"prior", "posterior_q05_q95"} and sobol["ST"].between(-0.1, 1.2).all()
 
 
 def test_nothing_to_redo(study):
@@ -169,7 +185,8 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
     reseeded = overlay(tmp_path / "seed.yaml", study={"seed": 7})
     flagged = params_changed(config, fixed, reseeded) - params_changed(config, fixed)
     histories = {f"figure_fig{n}_history_{shot}" for n, shot in [(11, "104S"), (12, "105S"), (13, "106S")]}
-    assert flagged == {"emulator", "calibrate", "predict_design", *histories}, flagged
+    # posterior_netcdf: its config_digest attribute is the calibrate slice's, seed included
+    assert flagged == {"emulator", "calibrate", "predict_design", "posterior_netcdf", "sensitivity", *histories}, flagged
 
 
 def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_path):
@@ -179,7 +196,8 @@ def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_pat
     results, config = study
     wider = overlay(tmp_path / "sd.yaml", observed={"sd_fraction": 0.02})
     flagged = params_changed(config, wider) - params_changed(config)
-    assert flagged == {"calibrate", "figure_fig09_features_emulator", "figure_fig10_features_hydrocode"}, flagged
+    assert flagged == {"calibrate", "posterior_netcdf", "figure_fig09_features_emulator",
+                       "figure_fig10_features_hydrocode"}, flagged
 
 
 def test_coverage_checks_fan_out_in_batches_of_trials(study):

@@ -16,6 +16,7 @@ keyed further (an emulator block index, a calibration's shots).
 | posterior_draws | the posterior rows run through the hydrocode for predictions |
 | figures | which training traces the history figures draw |
 | design_extension | the column of an input only a later shot reads (`design.base_shots`), keyed by shot and input |
+| sensitivity | the Sobol sequence's scrambling and the bootstrap of the Sobol indices |
 """
 from __future__ import annotations
 
@@ -23,7 +24,8 @@ import zlib
 
 import numpy as np
 
-STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension")
+STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
+           "sensitivity")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

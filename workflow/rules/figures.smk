@@ -1,4 +1,4 @@
-# The paper's fifteen figures (issue 7), one rule per figure, each `shockcal figures --figure NAME`
+# The paper's fifteen figures (issue 7) and the study's own (Sobol indices), one rule per figure, each `shockcal figures --figure NAME`
 # with its inputs passed as KEY=PATH pairs. PNG and PDF (figures.formats) under {RESULTS}/figures/;
 # the PNG goes into the report with a caption from workflow/report/. The figures, their categories
 # and the input keys each needs come from the catalogue (shockcal.plots.catalogue); this file only
@@ -23,6 +23,7 @@ INPUT_FILES = {
     "features": lambda shot: expand(rules.features.output[0], run_set="training", shot=shot),
     "predicted_features": lambda shot: expand(rules.features.output[0], run_set="predict", shot=shot),
     "posterior": lambda name: [rules.calibrate.output.samples.format(name=name)],
+    "sobol": lambda _: [rules.sensitivity.output[0]],
 }
 assert set(INPUT_FILES) == set(INPUT_KINDS), "figures.smk: INPUT_FILES must cover the catalogue's INPUT_KINDS"
 FIGURE_INPUTS = {

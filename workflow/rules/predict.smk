@@ -40,3 +40,36 @@ rule predict_emulator:
     shell:
         "shockcal predict-emulator --design {input.design}"
         " --emulator {params.emulator_dir} --out {output} > {log} 2>&1"
+
+
+rule posterior_netcdf:
+    """A calibration's posterior as ArviZ InferenceData (docs/calibration.md, "Outputs"); the joint one with the
+    features of the hydrocode runs at its draws as posterior_predictive."""
+    input:
+        samples=rules.calibrate.output.samples,
+        weighted=rules.calibrate.output.weighted,
+        predicted=lambda w: (
+            expand(rules.features.output[0], run_set="predict", shot=SHOTS) if w.name == "joint" else []
+        ),
+    output:
+        f"{RESULTS}/posterior/{{name}}.nc",
+    log:
+        f"{LOGS}/posterior_netcdf/{{name}}.log",
+    benchmark:
+        f"{BENCHMARKS}/posterior_netcdf/{{name}}.tsv"
+    wildcard_constraints:
+        name="|".join(CALIBRATIONS),
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(config, "calibrate"),  # the prior box; its digest is the file's config_digest
+        predicted=lambda w, input: (
+            "--predicted-features " + " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.predicted))
+            if input.predicted
+            else ""
+        ),
+    shell:
+        "shockcal posterior-netcdf --posterior {input.samples} {params.predicted} --out {output} > {log} 2>&1"
+
+
+ALL_TARGETS += expand(rules.posterior_netcdf.output[0], name=CALIBRATIONS)

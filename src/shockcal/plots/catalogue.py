@@ -1,4 +1,5 @@
-"""The paper's fifteen figures by file name: what each reads and which function draws it.
+"""The paper's fifteen figures, and the study's own after them, by file name: what each reads and which
+function draws it.
 
 Importing this module is cheap (the Snakefile lists the figures from it); plotting modules are
 imported when a figure is built.
@@ -37,6 +38,7 @@ INPUT_KINDS = {
     "features": "a shot's training features",
     "predicted_features": "the features of a shot's runs at posterior draws",
     "posterior": "a calibration's posterior draws (a shot or 'joint')",
+    "sobol": "the emulator's Sobol indices (sensitivity/sobol.csv)",
 }
 
 
@@ -161,6 +163,12 @@ def _history(shot, inputs, config):
                        seed=stream_seed(config["study"]["seed"], "figures"))
 
 
+def _sobol(inputs, config):
+    from shockcal.plots.sensitivity import sobol_indices
+
+    return sobol_indices(inputs.table("sobol"), _shots(config))
+
+
 def history_names(config) -> dict[str, str]:
     """{figure name: shot} for Figs 11-13 (the first three shots of the config)."""
     return {f"fig{11 + i}_history_{shot}": shot for i, shot in enumerate(_shots(config)[:3])}
@@ -175,7 +183,8 @@ _FEATURE_SPACE = ("shots", "observed.sd_fraction")
 
 
 def catalogue(config) -> dict[str, FigureSpec]:
-    """Every figure of the study, in the paper's order (cheap: nothing is imported until a figure is built)."""
+    """Every figure of the study: the paper's, in its order, then the study's own (cheap: nothing is imported
+    until a figure is built)."""
     shots = _shots(config)
     recorded = [s for s in shots if s in config.get("observed", {}).get("records", {})]
 
@@ -209,6 +218,8 @@ def catalogue(config) -> dict[str, FigureSpec]:
         FigureSpec("fig14_inadequate_model", "1 method", partial(_toy, "fig14_inadequate_model")),
         FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), _TRACE,
                    trace),
+        # beyond the paper
+        FigureSpec("sobol_indices", "6 sensitivity", _sobol, ("shots",), ("sobol",)),
     ]
     return {spec.name: spec for spec in specs}
 

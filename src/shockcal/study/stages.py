@@ -53,6 +53,8 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
                         "observed.sd_fraction", "checks.observed_units", "inputs"),
     # the posterior rows run through the hydrocode for predictions
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs"),
+    # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
+    "sensitivity": ("study.seed", "sensitivity", "inputs"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
     "figures": ("figures",),
 }

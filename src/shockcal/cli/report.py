@@ -1,0 +1,90 @@
+"""`shockcal report-tables`: the study's summary tables for the Snakemake report, each as CSV (for scripts)
+and as an HTML table (Snakemake 9's report shows HTML inline and offers CSV only as a download).
+
+From the posteriors (`shockcal calibrate` output and its metadata) it writes `posterior_summary.csv`
+(every calibration's weighted summary, one row per calibration and parameter, display units beside the
+Table IV ones) and `evidence.csv` (log evidence with its sd, Kish ESS, likelihood evaluations per
+calibration); from the emulator's `cv_rmse.csv`, `cross_validation.csv`; from the synthetic-truth
+checks' merged tables (`make check`), `coverage.csv` (per truth and parameter); from the Sobol table
+(`shockcal sensitivity`), `sobol.html` only (its CSV is the sensitivity stage's). Each table is written
+only when its inputs are given. No config is read.
+"""
+
+from __future__ import annotations
+
+from shockcal.cli import parse_pairs
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("report-tables", help="summary tables (CSV) of posteriors, evidence, CV and coverage "
+                                                    "for the report")
+    p.add_argument("--posteriors", nargs="+", default=[], metavar="NAME=POSTERIOR",
+                   help="calibrations' equal-weight draws (shockcal calibrate --out); their _summary.parquet is read")
+    p.add_argument("--cv-rmse", help="the emulator's cv_rmse.csv")
+    p.add_argument("--coverage", nargs="+", default=[], metavar="TRUTH=TABLE",
+                   help="merged synthetic-truth tables (shockcal coverage --out) by truth")
+    p.add_argument("--sobol", help="the Sobol table (shockcal sensitivity --out)")
+    p.add_argument("--out-dir", required=True, help="folder for the tables (NAME.csv and NAME.html)")
+    p.set_defaults(func=run)
+
+
+STYLE = ("<style>body{font-family:sans-serif;font-size:13px} table{border-collapse:collapse} "
+         "th,td{border:1px solid #ccc;padding:2px 6px;text-align:right} th{background:#eef}</style>")
+
+
+def _write(table, out, name: str, title: str, csv: bool = True) -> list[str]:
+    """`table` as out/NAME.csv (unless `csv` is False) and out/NAME.html; the names written."""
+    from shockcal.io import atomic_path
+
+    written = []
+    if csv:
+        with atomic_path(out / f"{name}.csv") as tmp:
+            table.to_csv(tmp, index=False, float_format="%.6g")
+        written.append(f"{name}.csv")
+    html = table.to_html(index=False, float_format=lambda v: f"{v:.4g}", na_rep="", border=0)
+    with atomic_path(out / f"{name}.html") as tmp:
+        tmp.write_text(f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{title}</title>{STYLE}</head>"
+                       f"<body><h3>{title}</h3>{html}</body></html>\n")
+    return [*written, f"{name}.html"]
+
+
+def run(args) -> int:
+    import logging
+    from pathlib import Path
+
+    import pandas as pd
+
+    from shockcal.cli.calibrate import summary_path
+    from shockcal.coverage import coverage_table
+    from shockcal.io import read_table, read_table_metadata
+
+    out = Path(args.out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    posteriors = parse_pairs(args.posteriors, "--posteriors")
+    if posteriors:
+        summaries, evidence = [], []
+        for name, path in posteriors.items():
+            summaries.append(read_table(summary_path(path)).assign(calibration=name))
+            meta = read_table_metadata(path)
+            evidence.append({"calibration": name, "shots": "+".join(meta.get("shots", [])),
+                             "log_evidence": meta.get("log_evidence"), "log_evidence_sd": meta.get("log_evidence_sd"),
+                             "ess_kish": meta.get("ess_kish"), "likelihood_evaluations": meta.get("likelihood_evaluations"),
+                             "draws": meta.get("retained"), "distinct_draws": meta.get("distinct_draws")})
+        summary = pd.concat(summaries, ignore_index=True)
+        summary = summary[["calibration", *[c for c in summary.columns if c != "calibration"]]]
+        written += _write(summary, out, "posterior_summary", "Posterior summaries (Table IV units)")
+        written += _write(pd.DataFrame(evidence), out, "evidence", "Log evidence per calibration")
+    if args.cv_rmse:
+        written += _write(read_table(args.cv_rmse), out, "cross_validation", "Emulator cross-validation (m/s)")
+    coverage = parse_pairs(args.coverage, "--coverage")
+    if coverage:
+        table = pd.concat([coverage_table(read_table(path)).assign(truth=truth) for truth, path in coverage.items()],
+                          ignore_index=True)
+        written += _write(table[["truth", *[c for c in table.columns if c != "truth"]]], out, "coverage",
+                          "Synthetic-truth coverage of the 90% intervals")
+    if args.sobol:
+        written += _write(read_table(args.sobol), out, "sobol", "Sobol indices of the emulated features "
+                          "(95% bootstrap half-widths)", csv=False)
+    logging.getLogger("shockcal.report").info("wrote %s in %s", ", ".join(written) or "nothing", out)
+    return 0

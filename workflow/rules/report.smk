@@ -1,0 +1,60 @@
+# The report's tables (snakemake --report shows HTML inline; each table also as CSV beside it): posterior
+# summaries, evidence, cross-validation, the Sobol indices, and the synthetic-truth coverage when `make check`
+# has made it.
+
+
+rule report_tables:
+    input:
+        posteriors=expand(rules.calibrate.output.samples, name=CALIBRATIONS),
+        summaries=expand(rules.calibrate.output.summary, name=CALIBRATIONS),
+        cv_rmse=rules.emulator.output.rmse,
+        sobol=rules.sensitivity.output[0],
+    output:
+        summary=report(
+            f"{RESULTS}/report/posterior_summary.html",
+            caption="../report/posterior_summary.rst",
+            category="4 posterior",
+        ),
+        evidence=report(f"{RESULTS}/report/evidence.html", caption="../report/evidence.rst", category="4 posterior"),
+        cv=report(
+            f"{RESULTS}/report/cross_validation.html",
+            caption="../report/cross_validation.rst",
+            category="3 emulator",
+        ),
+        sobol=report(f"{RESULTS}/report/sobol.html", caption="../report/sobol_table.rst", category="6 sensitivity"),
+        csv=[f"{RESULTS}/report/{name}.csv" for name in ("posterior_summary", "evidence", "cross_validation")],
+    log:
+        f"{LOGS}/report_tables.log",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        posteriors=lambda w, input: " ".join(f"{n}={p}" for n, p in zip(CALIBRATIONS, input.posteriors)),
+        out_dir=lambda w, output: os.path.dirname(output.summary),
+    shell:
+        "shockcal report-tables --posteriors {params.posteriors} --cv-rmse {input.cv_rmse} --sobol {input.sobol}"
+        " --out-dir {params.out_dir} > {log} 2>&1"
+
+
+rule report_coverage:
+    """The coverage table of `make check`'s merged tables. They are read, not declared as inputs: as inputs they
+    would send `all` through the checks again (2 h 45 min on the default study) whenever the emulator is
+    refitted. Their modification times in `params` rerun the table when a check is redone."""
+    output:
+        report(f"{RESULTS}/report/coverage.html", caption="../report/coverage.rst", category="4 posterior"),
+        f"{RESULTS}/report/coverage.csv",
+    log:
+        f"{LOGS}/report_coverage.log",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        coverage=" ".join(f"{t}={p}" for t, p in zip(CHECK_TRUTHS, CHECK_TARGETS)),
+        modified=[int(os.path.getmtime(p)) if os.path.exists(p) else None for p in CHECK_TARGETS],
+        out_dir=lambda w, output: os.path.dirname(output[0]),
+    shell:
+        "shockcal report-tables --coverage {params.coverage} --out-dir {params.out_dir} > {log} 2>&1"
+
+
+ALL_TARGETS.extend(rules.report_tables.output)
+# the coverage checks are outside `all` (make check); their table joins the report once they exist
+if all(os.path.exists(path) for path in CHECK_TARGETS):
+    ALL_TARGETS.extend(rules.report_coverage.output)
