@@ -80,6 +80,7 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
     Run ids must be whole numbers (1.0 reads as 1; 1.5 is an error) and unique; values finite;
     Johnson-Cook inputs non-negative; velocities and shear moduli positive (checked per shot by
     `ShotMapping.check_positive`). No rows is an error. Errors name the file, the row and the parameter.
+    Returned: `run` and the box's inputs the file has (other columns, e.g. notes, are left out).
     """
     design = read_table(path)
     columns = box.names() if columns is None else columns
@@ -104,7 +105,8 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
             raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
     design["run"] = design["run"].astype(np.int64)
     check_design_box(design, box, columns, path)
-    return design.reset_index(drop=True)
+    kept = ["run", *(name for name in box.names() if name in design.columns)]   # other columns: notes, not inputs
+    return design[kept].reset_index(drop=True)
 
 
 def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], source) -> None:

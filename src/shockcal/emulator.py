@@ -312,6 +312,8 @@ def training_data(design: pd.DataFrame, features: pd.DataFrame, shot: str, sourc
     from shockcal.io import check_unique, integer_ids, require_columns
 
     require_columns(features, ["run", *CALIBRATION_FEATURES], source)
+    if features.empty:
+        raise InputError(f"{source}: no runs (a features table with no rows)")
     features = integer_ids(features, "run", source)
     check_unique(features, "run", source, "run")
     for column in CALIBRATION_FEATURES:

@@ -63,7 +63,8 @@ def integer_ids(table: pd.DataFrame, column: str, source) -> pd.DataFrame:
     if bad.any():
         row = int(np.argmax(bad))
         value = raw.iloc[row]
-        what = "is blank" if pd.isna(value) or str(value).strip() == "" else f"= {value!r} is not a whole number"
+        shown = repr(value) if isinstance(value, str) else f"{value}"
+        what = "is blank" if pd.isna(value) or str(value).strip() == "" else f"= {shown} is not a whole number"
         raise InputError(f"{source}: row {row}: {column} {what}; {column} ids are integers")
     out = table.copy()
     out[column] = numbers.astype(np.int64)

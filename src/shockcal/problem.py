@@ -192,7 +192,7 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
         if rows.empty:
             raise InputError(f"{source}: no observed features for shot {shot} (have {sorted(names)})")
         if len(rows) > 1:
-            raise InputError(f"{source}: shot {shot} has {len(rows)} rows (rows {list(np.flatnonzero(names == shot))}); "
+            raise InputError(f"{source}: shot {shot} has {len(rows)} rows (rows {np.flatnonzero(names == shot).tolist()}); "
                              "give one row per shot")
         row = pd.to_numeric(rows.iloc[0][feature_names], errors="coerce").to_numpy(dtype=float)   # text: NaN
         bad = [f for f, v in zip(feature_names, row) if not np.isfinite(v) or v <= 0]

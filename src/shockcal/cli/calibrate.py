@@ -106,8 +106,8 @@ def run_check(args) -> int:
 
     config = load_stage_config(args.config, "calibrate_check")
     unique_shots(args.shots)
-    emulator = study_emulator(args.emulator, config)
     truths = hydro_truths(args)
+    emulator = study_emulator(args.emulator, config)
     truth = "emulator" if truths is None else "hydrocode"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
     table = synthetic_truth(emulator, args.shots,

@@ -102,7 +102,7 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     sampler = SamplerSettings(n_live=section["n_live"], n_eff=section["n_eff"], draws=draws, seed=seed,
                               cube_power=config["calibration"]["cube_power"],
                               max_evaluations=config["calibration"]["max_evaluations"])
-    boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots}
+    boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots if shot in config["shots"]}
     return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                                {name: box["unit"] for name, box in config["inputs"].items()}, prior_bounds(config),
                                {shot: box for shot, box in boxes.items() if box is not None},

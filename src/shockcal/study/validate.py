@@ -148,12 +148,12 @@ def check_semantics(config: dict, source: str = "config") -> None:
                 raise ConfigError(f"{source}: observed.{section}.{shot}: unknown shot; known shots are {sorted(config['shots'])}")
     for shot, features in observed["features"].items():
         check_observed(features, f"{source}: observed.features.{shot}", config["checks"]["observed_units"], ConfigError)
+    check_distinct(observed, source)
     for shot, features in observed["features"].items():
         box = velocity_box_m_s(config, shot)
         if box is not None:
             check_plateau(features, box, f"{source}: observed.features.{shot}",
                           config["checks"]["plateau_vs_velocity"], ConfigError)
-    check_distinct(observed, source)
     for shot, record in observed["records"].items():
         if not Path(record["path"]).is_file():
             raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
