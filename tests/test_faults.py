@@ -522,7 +522,7 @@ MISUSE_FAULTS = {
     "box-wider-than-emulator's": (
         lambda em, tmp, c: lambda: Problem.for_shots(em, ["104S"], _observed(), 0.01, "obs.csv",
                                                      prior_bounds(_narrow(c, "V1", low=0.0185)), {"V1": "cm/us"}),
-        ["104S: the prior box inputs.V1 = [0.0185, 0.0216] cm/us is not inside the box the emulator was fitted on "
+        ["calibration of 104S: the prior box inputs.V1 = [0.0185, 0.0216] cm/us is not inside the box the emulator was fitted on "
          "[0.0192, 0.0216] cm/us", "refit the emulator"]),
     "config-box-outside-emulator (emulator check)": (
         lambda em, tmp, c: lambda: em.check_study({}, prior_bounds(_narrow(c, "G1", high=0.6)), "emulator e/"),

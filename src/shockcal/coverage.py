@@ -39,7 +39,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     names = emulator.required_inputs(shots)
     box = emulator.input_bounds(names)
     if settings.bounds is not None:        # truths on the prior box the calibration samples
-        box = prior_box(names, settings.bounds, *box, "+".join(shots), settings.units)
+        box = prior_box(names, settings.bounds, *box, f"synthetic truth of {'+'.join(shots)}", settings.units)
     hydro_draws = None if truths is None else truths.table(names, shots)
     if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "

@@ -90,7 +90,7 @@ class Problem:
         names = emulator.required_inputs(shots)
         lower, upper = emulator.input_bounds(names)
         if bounds is not None:
-            lower, upper = prior_box(names, bounds, lower, upper, "+".join(shots), units or {})
+            lower, upper = prior_box(names, bounds, lower, upper, f"calibration of {'+'.join(shots)}", units or {})
         y = observed_vector(observed_table, shots, emulator.feature_names, source)
 
         def predict(theta):
