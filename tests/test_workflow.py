@@ -160,11 +160,18 @@ def test_added_design_rows_run_only_new_chunks(study, tmp_path):
 def test_added_shot_runs_only_its_simulations(study, tmp_path):
     quick = load_config(REPO / "config" / "config.yaml")
     new_shot = dict(quick["shots"]["106S"], target_mm=4.0)
-    record = dict(quick["observed"]["records"]["106S"])          # a fourth shot comes with its record
+    record = _own_record(quick, tmp_path)                        # a fourth shot comes with its record
     more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"records": {"107S": record}})
     jobs = pending_jobs(study[1], more)
     assert jobs["simulate"] == 4 and jobs["features_chunk"] == 4     # the 4 chunks of 107S only
     assert jobs["features"] == 1
+
+
+def _own_record(config, tmp_path) -> dict:
+    """A record file of the added shot's own: a copy of 106S's (one file for two shots is refused)."""
+    path = tmp_path / "Data_S107S.txt"
+    shutil.copy(REPO / config["observed"]["records"]["106S"]["path"], path)
+    return {**config["observed"]["records"]["106S"], "path": str(path)}
 
 
 def params_changed(*config_files) -> set[str]:
@@ -238,7 +245,7 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
     design.to_parquet(grown)
     shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4")
     more = overlay(tmp_path / "shot.yaml", design={"file": str(grown)}, inputs={"V4": box},
-                   shots={"107S": shot}, observed={"records": {"107S": dict(quick["observed"]["records"]["106S"])}})
+                   shots={"107S": shot}, observed={"records": {"107S": _own_record(quick, tmp_path)}})
     jobs = pending_jobs(config, more)
     assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
 

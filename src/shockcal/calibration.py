@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
-from shockcal.plausibility import check_observed_table
+from shockcal.plausibility import check_observed_table, check_plateau
 from shockcal.problem import Problem
 from shockcal.sampler import Posterior, SamplerSettings, sample
 
@@ -26,12 +26,20 @@ class CalibrationSettings:
         sd_fraction: observation sd as a fraction of each measured feature (0.01: 1%).
         check_units: whether to check that the measurements look like m/s and us (`shockcal.plausibility`).
         units: each parameter's unit, for the summary.
+        bounds: the prior box by input (native units), or None for the emulator's box; it must lie
+            inside the emulator's (`shockcal.problem.prior_box`).
+        velocity_boxes: shot -> its impact-velocity box (m/s), against which each shot's measured
+            plastic plateau is checked (`shockcal.plausibility.check_plateau`); shots absent: unchecked.
+        check_plateau: whether a plateau outside the band stops the calibration (else a warning).
     """
 
     sampler: SamplerSettings = SamplerSettings()
     sd_fraction: float = 0.01
     check_units: bool = True
     units: Mapping[str, str] = field(default_factory=dict)
+    bounds: Mapping[str, tuple[float, float]] | None = None
+    velocity_boxes: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    check_plateau: bool = True
 
     def with_sampler(self, **changes) -> CalibrationSettings:
         """These settings with some sampler settings changed (e.g. `seed`, `n_eff`)."""
@@ -52,8 +60,13 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     Returns:
         The `Posterior`; its `info` holds the shots, parameters, units and measured features too.
     """
-    problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction, source)
+    problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction, source, settings.bounds,
+                                settings.units)
     check_observed_table(observed, shots, source, settings.check_units)
+    for shot, features in zip(shots, problem.observed.reshape(len(shots), -1)):
+        if shot in settings.velocity_boxes:
+            check_plateau(dict(zip(emulator.feature_names, features)), settings.velocity_boxes[shot],
+                          f"{source}: shot {shot}", settings.check_plateau)
     posterior = sample(problem, settings.sampler, other_powers="ignore")
     units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
     posterior.units = units

@@ -13,7 +13,7 @@ from scipy import stats
 from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.errors import InputError, ShockcalError
 from shockcal.features import CALIBRATION_FEATURES
-from shockcal.problem import LAMBDA_Y_PRIOR, Problem, log_density
+from shockcal.problem import LAMBDA_Y_PRIOR, Problem, log_density, prior_box
 from shockcal.progress import progress
 
 log = logging.getLogger("shockcal.calibration")
@@ -38,6 +38,9 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     """
     trial_ids = range(trials) if isinstance(trials, int) else trials
     names = emulator.required_inputs(shots)
+    box = emulator.input_bounds(names)
+    if settings.bounds is not None:        # truths on the prior box the calibration samples
+        box = prior_box(names, settings.bounds, *box, f"synthetic truth of {'+'.join(shots)}", settings.units)
     hydro_draws = None if truths is None else truths.table(names, shots)
     if hydro_draws is not None and max(trial_ids, default=-1) >= len(hydro_draws):
         raise InputError(f"synthetic truth: trial {max(trial_ids)} needs hydrocode run number {max(trial_ids) + 1}, "
@@ -47,7 +50,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     for done, trial in enumerate(batch, 1):
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
         try:
-            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws)
+            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws, box)
         except ShockcalError as error:     # recorded and left out of the coverage, never the end of the batch
             log.warning("synthetic trial %d failed: %s", trial, error)
             rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
@@ -61,10 +64,10 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
 CHECK_COLUMNS = ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass", "status", "reason"]
 
 
-def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws) -> list[dict]:
+def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws, box) -> list[dict]:
     """One synthetic-truth trial: its truth, pseudo-measurement and calibration; a row per parameter."""
     if hydro_draws is None:
-        theta, eta = _emulator_truth(emulator, shots, names, rng)
+        theta, eta = _emulator_truth(emulator, shots, names, rng, box)
     else:
         theta, eta = hydro_draws[trial]
     lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial)
@@ -104,10 +107,10 @@ def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
                      f"(noise-free features {np.round(eta, 3).tolist()})")
 
 
-def _emulator_truth(emulator, shots, names, rng):
-    """(theta, features): theta uniform on the box, features from the emulator's predictive
-    distribution at theta (its error model's, block by block)."""
-    lower, upper = emulator.input_bounds(names)
+def _emulator_truth(emulator, shots, names, rng, box):
+    """(theta, features): theta uniform on the prior box (lower, upper), features from the emulator's
+    predictive distribution at theta (its error model's, block by block)."""
+    lower, upper = box
     theta = rng.uniform(lower, upper)
     mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
     features = np.empty(mean.shape[1])
@@ -127,12 +130,18 @@ class HydroTruths:
     def read(cls, design_path, feature_paths: dict, shots) -> HydroTruths:
         """From a design table and each shot's features table (CSV or Parquet); every shot calibrated
         needs its features."""
-        from shockcal.io import read_table
+        from shockcal.io import check_unique, integer_ids, read_table, require_columns
 
         missing = sorted(set(shots) - set(feature_paths))
         if missing:
             raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
-        return cls(read_table(design_path), {shot: read_table(path) for shot, path in feature_paths.items()})
+        tables = {}
+        for path in [design_path, *feature_paths.values()]:
+            table = read_table(path)
+            require_columns(table, ["run"] if path == design_path else ["run", "status", *CALIBRATION_FEATURES], path)
+            tables[path] = integer_ids(table, "run", path)
+            check_unique(tables[path], "run", path, "run")
+        return cls(tables[design_path], {shot: tables[path] for shot, path in feature_paths.items()})
 
     def table(self, names, shots) -> list:
         """(theta, features) of each usable run (every shot's features ok and positive), in run order."""

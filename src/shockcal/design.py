@@ -19,7 +19,7 @@ import pandas as pd
 
 from shockcal.errors import InputError
 from shockcal.hydro import JOHNSON_COOK_INPUTS, ShotParameters
-from shockcal.io import read_table, require_columns
+from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import range_problem
 
 log = logging.getLogger("shockcal.design")
@@ -96,14 +96,19 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
         box: the prior box the design must lie in (`check_design_box`).
         columns: the inputs that must be present (default: all of the box's).
 
-    Values must be finite; Johnson-Cook inputs non-negative; velocities and shear moduli positive
-    (checked per shot by `ShotMapping.check_positive`). Errors name the file, the row and the parameter.
+    Run ids must be whole numbers (1.0 reads as 1; 1.5 is an error) and unique; values finite;
+    Johnson-Cook inputs non-negative; velocities and shear moduli positive (checked per shot by
+    `ShotMapping.check_positive`). No rows is an error. Errors name the file, the row and the parameter.
+    Returned: `run` and the box's inputs the file has (other columns, e.g. notes, are left out).
     """
     design = read_table(path)
     columns = box.names() if columns is None else columns
     require_columns(design, columns, path)
+    if design.empty:
+        raise InputError(f"{path}: the design has no runs (a header and no rows)")
     if "run" not in design.columns:
         design.insert(0, "run", np.arange(len(design), dtype=np.int64))
+    design = integer_ids(design, "run", path)
     if design["run"].duplicated().any():
         dup = design.loc[design["run"].duplicated(), "run"].iloc[0]
         raise InputError(f"{path}: run id {dup} appears more than once")
@@ -119,7 +124,8 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
             raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
     design["run"] = design["run"].astype(np.int64)
     check_design_box(design, box, columns, path)
-    return design.reset_index(drop=True)
+    kept = ["run", *(name for name in box.names() if name in design.columns)]   # other columns: notes, not inputs
+    return design[kept].reset_index(drop=True)
 
 
 def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], source) -> None:
@@ -184,10 +190,18 @@ def write_design(design: pd.DataFrame, source: str, box: InputBox, path: str | P
     table = design[["run", *box.names()]].reset_index(drop=True)
     meta = {"table": "design", "source": source, "units": {name: box.units[name] for name in box.names()}}
     path = Path(path)
-    if path.is_file() and pd.read_parquet(path).equals(table):
+    if path.is_file() and _same_table(path, table):
         return False
     write_table(table, path, meta)
     return True
+
+
+def _same_table(path: Path, table: pd.DataFrame) -> bool:
+    """Whether the Parquet file at `path` holds `table` (an unreadable file does not: it is rewritten)."""
+    try:
+        return pd.read_parquet(path).equals(table)
+    except Exception:  # pyarrow raises many types for a damaged file; it is replaced either way
+        return False
 
 
 def chunk_fingerprints(design: pd.DataFrame, chunk_size: int) -> list[str]:

@@ -131,6 +131,7 @@ class Emulator:
         self.shots = [s for b in blocks for s in b.shots]
         self._bounds = bounds            # design input -> (min, max), native units
         self._shot_inputs = shot_inputs  # shot -> design inputs it depends on (SPEC section 3)
+        self.source = "the emulator"     # its directory, once loaded (for messages)
         for block in blocks:             # the array emulator's inputs by name: the map's, then base^column
             block.model._input_names = [*block.input_map.names, *(f"{base:g}^{column}" for base, column in block.input_map.powers)]
 
@@ -236,28 +237,100 @@ class Emulator:
 
     @classmethod
     def load(cls, directory) -> Emulator:
-        """Read a saved emulator, refusing other formats and versions with a clear message."""
+        """Read a saved emulator, refusing other formats, versions and feature sets, and damaged files
+        (truncated, empty, not JSON, arrays missing), with a one-line message naming the file."""
         directory = Path(directory)
-        meta_path = directory / "emulator.json"
-        if not meta_path.is_file() or not (directory / "emulator.npz").is_file():
+        meta_path, npz_path = directory / "emulator.json", directory / "emulator.npz"
+        if not meta_path.is_file() or not npz_path.is_file():
             raise InputError(f"{directory}: not an emulator directory (emulator.json + emulator.npz expected)")
-        meta = json.loads(meta_path.read_text())
-        if meta.get("format") != "shockcal-emulator" or meta.get("version") != FORMAT_VERSION:
+        refit = "refit it with `shockcal emulate` (snakemake reruns the emulator when its files are deleted)"
+        try:
+            meta = json.loads(meta_path.read_text())
+        except (ValueError, UnicodeDecodeError) as exc:      # JSONDecodeError is a ValueError
+            raise InputError(f"{meta_path}: not a readable emulator description ({exc}): truncated or damaged? "
+                             f"{refit}") from None
+        if not isinstance(meta, dict) or meta.get("format") != "shockcal-emulator" or meta.get("version") != FORMAT_VERSION:
+            meta = meta if isinstance(meta, dict) else {}
             raise InputError(f"{meta_path}: emulator format {meta.get('format')!r} version {meta.get('version')}; "
-                             f"this shockcal reads version {FORMAT_VERSION}: refit it with `shockcal emulate`")
-        with np.load(directory / "emulator.npz") as npz:
-            arrays = dict(npz)
-        blocks = [Block(InputMap.from_json(b["inputs"]), b["shots"], arrays[f"block{i}/runs"],
-                        PCGPEmulator.from_saved(b, arrays, f"block{i}/")) for i, b in enumerate(meta["blocks"])]
-        return cls(meta["structure"], blocks, {k: tuple(v) for k, v in meta["input_bounds"].items()},
-                   meta["shot_inputs"])
+                             f"this shockcal reads version {FORMAT_VERSION}: {refit}")
+        if meta.get("feature_names") != list(cls.feature_names):
+            raise InputError(f"{meta_path}: the emulator predicts features {meta.get('feature_names')}; this shockcal "
+                             f"calibrates {list(cls.feature_names)}: {refit}")
+        try:
+            with np.load(npz_path) as npz:
+                arrays = dict(npz)
+        except Exception as exc:  # zipfile, OSError, ValueError, EOFError: all mean a damaged file
+            raise InputError(f"{npz_path}: not a readable emulator array file ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''}): truncated or damaged? {refit}") from None
+        try:
+            blocks = [Block(InputMap.from_json(b["inputs"]), b["shots"], arrays[f"block{i}/runs"],
+                            PCGPEmulator.from_saved(b, arrays, f"block{i}/")) for i, b in enumerate(meta["blocks"])]
+            emulator = cls(meta["structure"], blocks, {k: tuple(v) for k, v in meta["input_bounds"].items()},
+                           meta["shot_inputs"])
+        except Exception as exc:  # a key or an array missing, wrong shapes: the two files do not belong together
+            raise InputError(f"{directory}: emulator.json and emulator.npz do not make an emulator "
+                             f"({type(exc).__name__}: {exc}): {refit}") from None
+        emulator.source = str(directory)
+        return emulator
+
+    def check_study(self, shot_inputs: Mapping[str, list[str]], bounds: Mapping[str, tuple[float, float]],
+                    label: str = "the emulator") -> None:
+        """Refuse to serve a study that reads the design differently from the one the emulator was fitted
+        for: a shot of both whose inputs differ (`shots.<shot>` velocity or shear-modulus inputs), or an
+        input whose prior box reaches outside the emulator's (a narrower box is fine: it lies inside).
+        Each is an InputError naming the shot or input and both sides.
+
+        Args:
+            shot_inputs: shot -> the design inputs the study maps onto it (`ShotMapping.inputs`).
+            bounds: the study's prior box by input (native units).
+            label: names the emulator (its directory) in messages.
+        """
+        for shot in [s for s in self.shots if s in shot_inputs]:
+            if list(self._shot_inputs[shot]) != list(shot_inputs[shot]):
+                raise InputError(f"{label}: shot {shot} reads the inputs {list(self._shot_inputs[shot])} in the "
+                                 f"emulator and {list(shot_inputs[shot])} in the config (shots.{shot}); refit the "
+                                 "emulator for this config")
+        for name in [k for k in self._bounds if k in bounds]:
+            (low, high), (lo, hi) = self._bounds[name], bounds[name]
+            slack = 1e-9 * (high - low)
+            if lo < low - slack or hi > high + slack:
+                raise InputError(f"{label}: the prior box inputs.{name} = [{lo:g}, {hi:g}] is not inside the box the "
+                                 f"emulator was fitted on [{low:g}, {high:g}]; refit the emulator on this box")
+
+    def check_inside(self, design: pd.DataFrame, source: str) -> None:
+        """An InputError naming `source`, the run and both values when a design row lies outside the box
+        the emulator was fitted on (its predictions there are extrapolations)."""
+        for name, (low, high) in self._bounds.items():
+            if name not in design:
+                continue
+            values = design[name].to_numpy(dtype=float)
+            slack = 1e-9 * (high - low)
+            outside = (values < low - slack) | (values > high + slack)
+            if outside.any():
+                first = int(np.argmax(outside))
+                raise InputError(f"{source}: run {design['run'].iloc[first]}: {name} = {values[first]:g} is outside the "
+                                 f"box the emulator was fitted on [{low:g}, {high:g}] ({int(outside.sum())} of "
+                                 f"{len(values)} runs)")
 
 
 def training_data(design: pd.DataFrame, features: pd.DataFrame, shot: str, source: str) -> pd.DataFrame:
-    """Join one shot's features to the design on `run`; drop failed or NaN runs with a logged count."""
-    from shockcal.io import require_columns
+    """Join one shot's features to the design on `run`; drop failed or NaN runs with a logged count.
+    Run ids must be whole numbers (1.0 reads as 1) and unique, feature values numbers or empty."""
+    from shockcal.io import check_unique, integer_ids, require_columns
 
     require_columns(features, ["run", *CALIBRATION_FEATURES], source)
+    if features.empty:
+        raise InputError(f"{source}: no runs (a features table with no rows)")
+    features = integer_ids(features, "run", source)
+    check_unique(features, "run", source, "run")
+    for column in CALIBRATION_FEATURES:
+        values = pd.to_numeric(features[column], errors="coerce")
+        text = values.isna() & features[column].notna()
+        if text.any():
+            row = int(np.argmax(text.to_numpy()))
+            raise InputError(f"{source}: row {row} (run {features['run'].iloc[row]}): {column} = "
+                             f"{features[column].iloc[row]!r} is not a number")
+        features = features.assign(**{column: values.astype(float)})
     unknown = sorted(set(features["run"]) - set(design["run"]))
     if unknown:
         raise InputError(f"{source}: runs {unknown[:5]} of shot {shot} are not in the design")

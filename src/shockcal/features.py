@@ -235,21 +235,30 @@ def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) ->
     return extract(t, v, settings).features
 
 
-def features_table(traces, settings: ExtractorSettings) -> pd.DataFrame:
+def features_table(traces, settings: ExtractorSettings, source: str = "simulations") -> pd.DataFrame:
     """One row per simulated run (a simulations table: run, status, reason, t_us, v_m_s): run, status,
     reason and the ten features.
 
     Failed simulations keep their status and reason; a trace the extractor cannot read becomes
-    status "failed" with the extractor's reason.
+    status "failed" with the extractor's reason. A table that is not a simulations table (columns
+    missing, no rows, run ids that are not whole numbers, traces that are not lists of numbers: a CSV
+    copy of a chunk) is an InputError naming `source` and the run.
     """
     import pandas as pd
 
+    from shockcal.io import integer_ids, require_columns
+
+    require_columns(traces, ["run", "status", "reason", "t_us", "v_m_s"], source)
+    if traces.empty:
+        raise InputError(f"{source}: no runs (a simulations table with no rows)")
+    traces = integer_ids(traces, "run", source)
     rows = []
     for record in traces.to_dict("records"):
         row = {"run": int(record["run"]), "status": record["status"], "reason": record["reason"]}
         if record["status"] == "ok":
+            t, v = (_trace_column(record, column, source) for column in ("t_us", "v_m_s"))
             try:
-                row.update(extract_features(record["t_us"], record["v_m_s"], settings))
+                row.update(extract_features(t, v, settings))
             except FeatureError as exc:
                 row.update(status="failed", reason=f"feature extraction: {exc}")
         rows.append(row)
@@ -257,6 +266,22 @@ def features_table(traces, settings: ExtractorSettings) -> pd.DataFrame:
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
+
+
+def _trace_column(record: dict, column: str, source) -> np.ndarray:
+    """A run's trace column (`t_us` or `v_m_s`) as floats; text (a chunk saved as CSV) or a trace of
+    another length than its partner is an InputError naming the run."""
+    value = record[column]
+    if isinstance(value, str) or np.ndim(value) != 1:
+        raise InputError(f"{source}: run {record['run']}: {column} is {type(value).__name__}, not a list of numbers "
+                         "(simulation tables are Parquet, as `shockcal simulate` writes them)")
+    try:
+        values = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{source}: run {record['run']}: {column} holds values that are not numbers") from None
+    if len(values) != len(np.asarray(record["t_us"] if column == "v_m_s" else record["v_m_s"])):
+        raise InputError(f"{source}: run {record['run']}: t_us and v_m_s differ in length")
+    return values
 
 
 def record_features(path, settings: ExtractorSettings, shot: str, time_column=None, velocity_column=None) -> dict:
@@ -276,7 +301,13 @@ def _column(value):
 
 
 def check_failures(table, max_fraction: float, shot: str) -> None:
-    """Log the excluded count; stop when more than `max_fraction` of the runs failed."""
+    """Log the excluded count; stop when more than `max_fraction` of the runs failed, or when there are
+    no runs (or no `status` column: not a features table)."""
+    from shockcal.io import require_columns
+
+    require_columns(table, ["run", "status", "reason"], f"features of shot {shot}")
+    if table.empty:
+        raise InputError(f"features of shot {shot}: no runs (a features table with no rows)")
     failed = table[table["status"] != "ok"]
     if failed.empty:
         log.info("shot %s: all %d runs have features", shot, len(table))

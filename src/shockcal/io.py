@@ -14,6 +14,7 @@ import json
 import os
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
@@ -33,23 +34,69 @@ def read_table(path: str | Path) -> pd.DataFrame:
         if suffix in PARQUET_SUFFIXES:
             return pd.read_parquet(path)
         if suffix in CSV_SUFFIXES:
-            return pd.read_csv(path)
+            return pd.read_csv(path, encoding=text_encoding(path))
     except Exception as exc:  # pyarrow and pandas raise many types; all mean "unreadable"
         hint = (" (truncated or corrupted? if shockcal wrote it, delete it and rerun: snakemake recomputes only"
                 " the missing files)") if suffix in PARQUET_SUFFIXES else ""
-        raise InputError(f"table {path} could not be read: {exc}{hint}") from exc
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputError(f"table {path} could not be read: {reason}{hint}") from None
     raise InputError(f"table {path}: unknown format '{suffix}' (expected .parquet, .pq or .csv)")
+
+
+def text_encoding(path: str | Path) -> str:
+    """The encoding of a text file from its byte-order mark: UTF-16 (either byte order), UTF-8 with
+    a BOM (the mark is dropped), else UTF-8."""
+    with open(path, "rb") as handle:
+        head = handle.read(4)
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return "utf-16"
+    return "utf-8-sig"
+
+
+def integer_ids(table: pd.DataFrame, column: str, source) -> pd.DataFrame:
+    """`table` with its id column `column` (e.g. `run`) as int64; ids written as 1.0 are whole numbers
+    and read as 1. A blank, non-numeric or fractional id (1.5) is an InputError naming `source`, the
+    row (0-based, as a table reader counts them) and the value."""
+    raw = table[column]
+    values = pd.to_numeric(raw, errors="coerce")
+    numbers = values.to_numpy(dtype=float)
+    bad = ~np.isfinite(numbers) | (numbers != np.round(numbers))
+    if bad.any():
+        row = int(np.argmax(bad))
+        value = raw.iloc[row]
+        shown = repr(value) if isinstance(value, str) else f"{value}"
+        what = "is blank" if pd.isna(value) or str(value).strip() == "" else f"= {shown} is not a whole number"
+        raise InputError(f"{source}: row {row}: {column} {what}; {column} ids are integers")
+    out = table.copy()
+    out[column] = numbers.astype(np.int64)
+    return out
+
+
+def check_unique(table: pd.DataFrame, column: str, source, what: str = "id") -> None:
+    """An InputError naming `source` and the rows when a value of `column` appears more than once."""
+    repeated = table[column].duplicated(keep=False).to_numpy()
+    if repeated.any():
+        value = table[column].to_numpy()[repeated][0]
+        rows = np.flatnonzero(table[column].to_numpy() == value).tolist()
+        raise InputError(f"{source}: {column} {value} appears more than once (rows {rows[:5]}); one row per {what}")
 
 
 def read_tables(paths, keys: list[str], what: str) -> pd.DataFrame:
     """Tables holding parts of one table (a shot's chunks, a check's batches) as one, stably sorted by
-    the first key column; rows repeating `keys` across the parts are an InputError naming the files."""
-    parts = [read_table(path) for path in paths]
+    the first key column; rows repeating `keys` (in one part or across parts) are an InputError naming
+    the files, and so are a key column missing and (`run`, `trial`) ids that are not whole numbers."""
+    parts = []
+    for path in paths:
+        part = read_table(path)
+        require_columns(part, keys, path)
+        parts.append(integer_ids(part, keys[0], path) if keys[0] in ("run", "trial") else part)
     table = pd.concat(parts, ignore_index=True)
     repeated = table.duplicated(keys, keep=False)
     if repeated.any():
         value = table.loc[repeated, keys[0]].iloc[0]
         holders = [str(path) for path, part in zip(paths, parts) if (part[keys[0]] == value).any()]
+        if len(holders) == 1:
+            raise InputError(f"{holders[0]}: {keys[0]} {value} appears more than once in this {what} table")
         raise InputError(f"{keys[0]} {value} is in more than one {what} table: {', '.join(holders)}")
     return table.sort_values(keys[0], kind="stable").reset_index(drop=True)
 

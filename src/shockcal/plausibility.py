@@ -2,7 +2,8 @@
 
 A design point outside the prior box (shockcal.design), a VISAR record (shockcal.records) or observed
 features (config values, the table calibration reads) whose magnitudes fit another unit better than
-the one shockcal reads them in: each check names the file, key or row, what looks wrong, the unit
+the one shockcal reads them in, and a plastic plateau that does not fit its shot's impact velocity
+(`check_plateau`: the records or features of two shots swapped): each check names the file, key or row, what looks wrong, the unit
 the value would fit, and the opt-out that says it is intended (docs/workflow.md, "Bad input and
 what you get").
 """
@@ -33,6 +34,15 @@ OTHER_UNITS = {
 }
 
 OBSERVED_OPT_OUT = "checks.observed_units: false"
+
+# The plastic plateau of a symmetric impact (flyer and target of one material) against the impact
+# velocity: the free surface moves at about the impact velocity, a little less with strength. Over the
+# 120 training runs of the quick study (results/quick, 40 per shot) v_plastic / impact velocity is
+# 0.905-0.996 (104S 0.922-0.996, 105S 0.905-0.994, 106S 0.911-0.995); the published measurements lie at
+# 0.93-1.05 of their shot's velocity box. A plateau outside [0.85 v_min, 1.05 v_max] of its shot's box is
+# another shot's record or features (adjacent shots of the paper differ by 1.3-1.7x).
+PLATEAU_RATIO = (0.85, 1.05)
+PLATEAU_OPT_OUT = "checks.plateau_vs_velocity: false"
 
 
 def range_problem(what: str, value: float, unit: str, bounds, label: str = "the plausible range") -> str | None:
@@ -79,3 +89,51 @@ def check_observed_table(table, shots, source: str, enabled: bool) -> None:
     for shot in shots:
         rows = table[table["shot"].astype(str) == shot]
         check_observed(rows.iloc[0].to_dict(), f"{source}: shot {shot}", enabled)
+
+
+def plateau_problem(v_plastic_m_s: float, velocity_box_m_s) -> str | None:
+    """None when the plastic plateau (m/s) lies in PLATEAU_RATIO times the shot's impact-velocity box
+    (m/s); else what is wrong."""
+    lo, hi = velocity_box_m_s
+    low, high = PLATEAU_RATIO[0] * lo, PLATEAU_RATIO[1] * hi
+    if low <= v_plastic_m_s <= high:
+        return None
+    return (f"the plastic plateau v_plastic = {v_plastic_m_s:.4g} m/s is outside [{low:.4g}, {high:.4g}] m/s, "
+            f"{PLATEAU_RATIO[0]:g}-{PLATEAU_RATIO[1]:g} x the shot's impact velocity box [{lo:.4g}, {hi:.4g}] m/s "
+            "(in a symmetric impact the free surface moves at about the impact velocity): another shot's record "
+            "or features?")
+
+
+def check_plateau(features, velocity_box_m_s, where: str, enabled: bool, error=InputError) -> None:
+    """Raise `error` naming `where` when `plateau_problem` finds one in a shot's `features` (a mapping
+    holding `v_plastic`, m/s; warn instead when not `enabled`). Features whose units look wrong
+    (`feature_problems`) are left to `check_observed`, which says so."""
+    if feature_problems(features):
+        return
+    problem = plateau_problem(float(features["v_plastic"]), velocity_box_m_s)
+    if problem is None:
+        return
+    if enabled:
+        raise error(f"{where}: {problem}; if it is intended, set {PLATEAU_OPT_OUT}")
+    log.warning("%s: %s (accepted: %s)", where, problem, PLATEAU_OPT_OUT)
+
+
+def release_times_us(flyer_mm: float, target_mm: float, rho0_g_cc: float, c1_Mbar: float, shear_modulus_Mbar: float
+                     ) -> tuple[float, float]:
+    """(first arrival, release arrival) at the target's free surface, us after impact, of a symmetric
+    impact, from 1-D wave paths.
+
+    Speeds: the bulk sound speed c_bulk = sqrt(c1 / rho0) carries the plastic shock (its lower bound);
+    the longitudinal elastic speed c_L = sqrt(c_bulk^2 + 4 G / (3 rho0)) carries the elastic precursor and
+    the head of a release. The precursor crosses the target first: arrival = target / c_L. The plastic
+    shock crosses the flyer and reflects from its back as a release, whose head crosses the flyer and
+    the target: release = flyer / c_bulk + (flyer + target) / c_L, so the plateau lasts
+    flyer / c_bulk + flyer / c_L after the arrival. (The precursor's own reflection, 2 flyer / c_L after
+    the arrival, carries only the precursor's amplitude.) The hydrocode's plateau of the paper's shots
+    falls 3% at 1.12-1.22 us after the arrival, 0.07-0.13 us before this estimate (the shock is faster
+    than c_bulk and a release faster in compressed metal): a window reaching the estimate surely holds
+    the release."""
+    c_bulk = (c1_Mbar / rho0_g_cc) ** 0.5                                     # cm/us
+    c_l = (c_bulk**2 + 4.0 * shear_modulus_Mbar / (3.0 * rho0_g_cc)) ** 0.5    # cm/us
+    flyer, target = flyer_mm * 0.1, target_mm * 0.1                            # cm
+    return target / c_l, flyer / c_bulk + (flyer + target) / c_l

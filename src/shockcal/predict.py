@@ -8,6 +8,7 @@ units), so the workflow runs it through `shockcal simulate` and `shockcal featur
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -17,8 +18,10 @@ from shockcal.io import require_columns
 
 log = logging.getLogger(__name__)
 
+
 def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, seed: int,
-                          source: str = "posterior") -> pd.DataFrame:
+                          source: str = "posterior", bounds: Mapping[str, tuple[float, float]] | None = None
+                          ) -> pd.DataFrame:
     """`n` rows drawn (seeded, without replacement when possible) from the posterior samples.
 
     Args:
@@ -27,13 +30,30 @@ def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, see
         n: rows to draw.
         seed: the draw's seed.
         source: names `posterior` in errors.
+        bounds: the study's prior box by input (native units): every sample must lie in it.
 
-    Returns a design table: `run` 0..n-1 and the inputs `names`. An empty table or a missing input is
-    an InputError naming `source`.
+    Returns a design table: `run` 0..n-1 and the inputs `names`. An empty table, a missing input, a
+    value that is not a finite number, or a sample outside `bounds` (a posterior of another study or
+    box) is an InputError naming `source`, the row and the input.
     """
     if posterior.empty:
         raise InputError(f"{source}: posterior has no samples; cannot draw {n} posterior runs")
     require_columns(posterior, names, source)
+    for name in names:
+        values = pd.to_numeric(posterior[name], errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise InputError(f"{source}: row {row}: {name} = {posterior[name].iloc[row]!r} is not a finite number")
+        if bounds is not None and name in bounds:
+            low, high = bounds[name]
+            slack = 1e-9 * (high - low)
+            outside = (values < low - slack) | (values > high + slack)
+            if outside.any():
+                row = int(np.argmax(outside))
+                raise InputError(f"{source}: row {row}: {name} = {values[row]:g} is outside the prior box inputs.{name} "
+                                 f"[{low:g}, {high:g}] ({int(outside.sum())} of {len(values)} samples): a posterior "
+                                 "of another box or study?")
     replace = len(posterior) < n
     if replace:
         log.warning("%s: only %d samples for %d posterior runs; drawing with replacement", source, len(posterior), n)

@@ -68,19 +68,29 @@ class Problem:
                    np.asarray(emulator.upper, dtype=float), label, emulator.error_groups())
 
     @classmethod
-    def for_shots(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed"
+    def for_shots(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed",
+                  bounds: Mapping[str, tuple[float, float]] | None = None, units: Mapping[str, str] | None = None
                   ) -> Problem:
         """The study's problem: the inputs `shots` need, their box, and their measured features.
 
         Args:
             emulator: the study's `Emulator` (design inputs in native units).
-            shots: the shots calibrated together (one: a single-shot calibration).
+            shots: the shots calibrated together (one: a single-shot calibration; a shot twice is an error).
             observed_table: measured features, one row per shot (m/s).
             sd_fraction: observation sd as a fraction of each measured feature.
             source: names the table in errors.
+            bounds: the prior box by input (native units; the study config's `inputs`), or None for the
+                emulator's box. It must lie inside the box the emulator was fitted on (`prior_box`).
+            units: each input's unit, for messages.
         """
+        shots = list(shots)
+        twice = sorted({shot for shot in shots if shots.count(shot) > 1})
+        if twice:
+            raise InputError(f"shots {shots}: {', '.join(twice)} listed more than once; name each shot once")
         names = emulator.required_inputs(shots)
         lower, upper = emulator.input_bounds(names)
+        if bounds is not None:
+            lower, upper = prior_box(names, bounds, lower, upper, f"calibration of {'+'.join(shots)}", units or {})
         y = observed_vector(observed_table, shots, emulator.feature_names, source)
 
         def predict(theta):
@@ -144,17 +154,47 @@ class Problem:
         return out
 
 
+def prior_box(names, bounds: Mapping[str, tuple[float, float]], emulator_lower, emulator_upper, label: str,
+              units: Mapping[str, str]) -> tuple[np.ndarray, np.ndarray]:
+    """The prior box of `names` from `bounds` (the study's `inputs`, native units), checked against the
+    box the emulator was fitted on (`emulator_lower`, `emulator_upper`).
+
+    A prior box inside the emulator's is calibrated on as it is (a narrower prior is a statement about
+    the inputs, and the emulator is valid on it); one reaching outside it would ask the emulator to
+    extrapolate, and is an InputError naming the input and both boxes. An input the box lacks is an
+    InputError too."""
+    lower, upper = [], []
+    for name, low, high in zip(names, emulator_lower, emulator_upper):
+        if name not in bounds:
+            raise InputError(f"{label}: the prior box has no input {name}, which the emulator's calibration needs")
+        lo, hi = (float(b) for b in bounds[name])
+        slack = 1e-9 * (high - low)       # float noise of a box written out and read back
+        if lo < low - slack or hi > high + slack:
+            unit = "" if units.get(name, "-") == "-" else f" {units[name]}"
+            raise InputError(f"{label}: the prior box inputs.{name} = [{lo:g}, {hi:g}]{unit} is not inside the box the "
+                             f"emulator was fitted on [{low:g}, {high:g}]{unit}; refit the emulator on this box, or give "
+                             f"inputs.{name} inside it")
+        lower.append(max(lo, low))
+        upper.append(min(hi, high))
+    return np.array(lower), np.array(upper)
+
+
 def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> np.ndarray:
-    """The measured features of `shots`, shot-major; missing or non-positive values are errors."""
+    """The measured features of `shots`, shot-major; a shot without a row or with two (whatever their
+    values: which one is meant cannot be told), and missing or non-positive values, are errors."""
     from shockcal.io import require_columns  # pyarrow's import is paid only by the study
 
     require_columns(table, ["shot", *feature_names], source)
+    names = table["shot"].astype(str).str.strip()
     values = []
     for shot in shots:
-        rows = table[table["shot"].astype(str) == shot]
+        rows = table[names == shot]
         if rows.empty:
-            raise InputError(f"{source}: no observed features for shot {shot} (have {sorted(table['shot'].astype(str))})")
-        row = rows.iloc[0][feature_names].to_numpy(dtype=float)
+            raise InputError(f"{source}: no observed features for shot {shot} (have {sorted(names)})")
+        if len(rows) > 1:
+            raise InputError(f"{source}: shot {shot} has {len(rows)} rows (rows {np.flatnonzero(names == shot).tolist()}); "
+                             "give one row per shot")
+        row = pd.to_numeric(rows.iloc[0][feature_names], errors="coerce").to_numpy(dtype=float)   # text: NaN
         bad = [f for f, v in zip(feature_names, row) if not np.isfinite(v) or v <= 0]
         if bad:
             raise InputError(f"{source}: shot {shot}: observed feature(s) {bad} missing or not positive")

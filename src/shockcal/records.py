@@ -77,12 +77,16 @@ def check_plausible(t: np.ndarray, v: np.ndarray, source) -> None:
 
 def _read_table(path: Path) -> pd.DataFrame:
     """A table with named columns: from a '%' header line, or a header line; fields separated by
-    whitespace (tabs), ';' or ','. A binary file, rows of unequal width or decimal commas are errors
-    naming the file and the line."""
+    whitespace (tabs), ';' or ','; UTF-8 (with or without a byte-order mark) or UTF-16, any line ends.
+    A binary file, rows of unequal width or decimal commas are errors naming the file and the line."""
     raw = path.read_bytes()
-    if b"\0" in raw:
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):       # UTF-16 (a spreadsheet's "Unicode text")
+        text = raw.decode("utf-16", errors="replace")
+    elif b"\0" in raw:
         raise InputError(f"record {path}: a binary file, not a text table of time and velocity columns")
-    lines = raw.decode(errors="replace").splitlines()
+    else:
+        text = raw.decode("utf-8-sig", errors="replace")     # a UTF-8 byte-order mark is dropped
+    lines = text.splitlines()
     comments = [line.lstrip("%").strip() for line in lines if line.startswith("%")]
     numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip() and not line.startswith("%")]
     if not numbered:

@@ -10,3 +10,6 @@ PER_S_TO_PER_US = 1.0e-6
 CM_US_TO_M_S = 1.0e4
 MBAR_TO_GPA = 100.0
 MBAR_TO_MPA = 1.0e5
+
+# a velocity input's unit (config `inputs.<name>.unit`) -> the factor to m/s
+VELOCITY_TO_M_S = {"cm/us": CM_US_TO_M_S, "m/s": 1.0, "km/s": 1.0e3, "mm/us": 1.0e3}

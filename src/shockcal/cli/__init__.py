@@ -42,14 +42,28 @@ def add_config_argument(parser, help: str = "study config YAML") -> None:
 
 
 def parse_pairs(pairs: list[str], option: str) -> dict[str, str]:
-    """['104S=a.parquet', ...] -> {'104S': 'a.parquet', ...}; a malformed pair is an InputError."""
+    """['104S=a.parquet', ...] -> {'104S': 'a.parquet', ...}; a malformed pair, a shot given twice or one
+    file given for two shots is an InputError."""
     parsed = {}
     for pair in pairs:
         key, sep, path = pair.partition("=")
         if not sep or not key or not path:
             raise InputError(f"{option}: '{pair}' is not SHOT=FILE")
+        if key in parsed:
+            raise InputError(f"{option}: shot {key} is given twice ({key}={parsed[key]} and {pair}); give each shot once")
+        same = [shot for shot, other in parsed.items() if os.path.realpath(other) == os.path.realpath(path)]
+        if same:
+            raise InputError(f"{option}: {path} is given for shots {same[0]} and {key}; each shot has its own table")
         parsed[key] = path
     return parsed
+
+
+def unique_shots(shots: list[str], option: str = "--shots") -> list[str]:
+    """The shots of a command line, each once; a shot given twice is an InputError naming it."""
+    twice = sorted({shot for shot in shots if shots.count(shot) > 1})
+    if twice:
+        raise InputError(f"{option}: {', '.join(twice)} given more than once ({' '.join(shots)}); name each shot once")
+    return shots
 
 
 def parse_span(text: str, option: str) -> tuple[int | None, int | None]:

@@ -8,7 +8,7 @@ weights: the exact result); config keys: `calibration`, `observed.sd_fraction`, 
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs, parse_span
+from shockcal.cli import add_config_argument, parse_pairs, parse_span, unique_shots
 
 
 def register(subparsers) -> None:
@@ -42,6 +42,19 @@ def register(subparsers) -> None:
     m.set_defaults(func=run_coverage)
 
 
+def study_emulator(directory, config: dict):
+    """The emulator in `directory`, checked against the study's shot mappings and prior box
+    (`Emulator.check_study`)."""
+    from shockcal.emulator import Emulator
+    from shockcal.study.adapters import shot_mapping
+    from shockcal.study.config import prior_bounds
+
+    emulator = Emulator.load(directory)
+    emulator.check_study({shot: shot_mapping(config, shot).inputs() for shot in config["shots"]},
+                         prior_bounds(config), f"emulator {directory}")
+    return emulator
+
+
 def summary_path(out, kind: str = "summary"):
     """The table of `kind` ("summary", "weighted") beside the posterior samples `out`."""
     from pathlib import Path
@@ -54,13 +67,13 @@ def run(args) -> int:
     import logging
 
     from shockcal.calibration import calibrate
-    from shockcal.emulator import Emulator
     from shockcal.io import read_table, write_table
     from shockcal.study.adapters import calibration_settings
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate")
-    emulator = Emulator.load(args.emulator)
+    unique_shots(args.shots)
+    emulator = study_emulator(args.emulator, config)
     observed = read_table(args.observed)
     settings = calibration_settings(config, args.shots)
     if args.n_eff is not None:
@@ -88,19 +101,20 @@ def run_check(args) -> int:
     import logging
 
     from shockcal.coverage import coverage_table, synthetic_truth
-    from shockcal.emulator import Emulator
     from shockcal.io import write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import calibration_settings
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "calibrate_check")
+    unique_shots(args.shots)
     if not getattr(args, "verbose", False):   # the batch's progress line (count, time left) says enough; each trial's sampler lines: -v
         logging.getLogger("shockcal.sampler").setLevel(logging.WARNING)
     truths = hydro_truths(args)
+    emulator = study_emulator(args.emulator, config)
     truth = "emulator" if truths is None else "hydrocode"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
-    table = synthetic_truth(Emulator.load(args.emulator), args.shots,
+    table = synthetic_truth(emulator, args.shots,
                             calibration_settings(config, args.shots, check=True), trials,
                             seed=stream_seed(config["study"]["seed"], "check", truth, *args.shots), truths=truths)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"

@@ -36,7 +36,7 @@ def run(args) -> int:
     import pandas as pd
 
     from shockcal.features import check_failures, record_features
-    from shockcal.io import read_table, write_table
+    from shockcal.io import write_table
     from shockcal.study.adapters import extractor_settings
     from shockcal.study.stages import load_stage_config
 
@@ -52,8 +52,8 @@ def run(args) -> int:
         if args.tables:
             table = read_tables(args.tables, ["run"], "features")
         else:
-            traces = pd.concat([read_table(path) for path in args.traces], ignore_index=True)
-            table = features_table(traces, extractor_settings(config, args.shot))
+            traces = read_tables(args.traces, ["run"], "simulations")
+            table = features_table(traces, extractor_settings(config, args.shot), ", ".join(args.traces))
         if not args.no_failure_budget:
             check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
     write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,

@@ -25,16 +25,23 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.io import read_table, write_table
+    from shockcal.errors import InputError
+    from shockcal.io import read_table, read_table_metadata, write_table
     from shockcal.predict import draw_posterior_design
     from shockcal.seeds import stream_seed
-    from shockcal.study.config import input_names
+    from shockcal.study.config import input_names, prior_bounds
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "predict")
     n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
     seed = stream_seed(config["study"]["seed"], "posterior_draws") if args.seed is None else args.seed
-    design = draw_posterior_design(read_table(args.posterior), input_names(config), n_runs, seed, source=args.posterior)
+    posterior = read_table(args.posterior)
+    shots = read_table_metadata(args.posterior).get("shots") if args.posterior.endswith((".parquet", ".pq")) else None
+    if shots is not None and sorted(shots) != sorted(config["shots"]):
+        raise InputError(f"{args.posterior}: a posterior of shots {shots}; predict draws from the joint posterior of the "
+                         f"config's shots {sorted(config['shots'])}")
+    design = draw_posterior_design(posterior, input_names(config), n_runs, seed, source=args.posterior,
+                                   bounds=prior_bounds(config))
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})
@@ -45,16 +52,17 @@ def run(args) -> int:
 def run_emulator(args) -> int:
     import logging
 
-    from shockcal.emulator import Emulator
+    from shockcal.cli.calibrate import study_emulator
     from shockcal.io import write_table
     from shockcal.predict import emulator_predictions
     from shockcal.study.adapters import load_study_design
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "emulate_predict")
-    emulator = Emulator.load(args.emulator)
+    emulator = study_emulator(args.emulator, config)
     shots = [s for s in config["shots"] if s in emulator.shots]
     design = load_study_design(args.design, config)
+    emulator.check_inside(design, args.design)
     table = emulator_predictions(emulator, design, shots)
     write_table(table, args.out, {"table": "emulator_predictions", "design": args.design, "emulator": args.emulator,
                                   "units": "m/s"})

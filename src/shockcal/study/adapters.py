@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from shockcal.design import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.seeds import stream_seed
-from shockcal.study.config import end_time_us, prior_bounds, shot_config
+from shockcal.study.config import end_time_us, prior_bounds, shot_config, velocity_box_m_s
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -89,8 +89,10 @@ def emulator_spec(config: dict, shots) -> EmulatorSpec:
 
 def calibration_settings(config: dict, shots, check: bool = False) -> CalibrationSettings:
     """`calibration` (with `check`, the synthetic-truth trials' `calibration.check`, whose draws are its
-    n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units` and the
-    inputs' units, seeded by the shots' "calibration" stream of study.seed (a trial reseeds from its own)."""
+    n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units`, the
+    prior box `inputs` and their units, the shots' impact-velocity boxes for the plateau check
+    (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), seeded by the shots'
+    "calibration" stream of study.seed (a trial reseeds from its own)."""
     from shockcal.calibration import CalibrationSettings
     from shockcal.sampler import SamplerSettings
 
@@ -100,8 +102,11 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     sampler = SamplerSettings(n_live=section["n_live"], n_eff=section["n_eff"], draws=draws, seed=seed,
                               cube_power=config["calibration"]["cube_power"],
                               max_evaluations=config["calibration"]["max_evaluations"])
+    boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots if shot in config["shots"]}
     return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
-                               {name: box["unit"] for name, box in config["inputs"].items()})
+                               {name: box["unit"] for name, box in config["inputs"].items()}, prior_bounds(config),
+                               {shot: box for shot, box in boxes.items() if box is not None},
+                               config["checks"]["plateau_vs_velocity"])
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None) -> pd.DataFrame:
@@ -165,20 +170,28 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
 
 def observed_table(config: dict) -> pd.DataFrame:
     """The measured features of every shot (one row per shot: shot, source, the ten features), from
-    the VISAR records through the extractor (`observed.source: records`) or the published values."""
+    the VISAR records through the extractor (`observed.source: records`) or the published values; a
+    plastic plateau that does not fit the shot's impact velocity (`checks.plateau_vs_velocity`) is an
+    InputError naming the shot and the record."""
     import pandas as pd
 
     from shockcal.features import COLUMNS, record_features
+    from shockcal.plausibility import check_plateau
 
     observed = config["observed"]
     rows = []
     for shot in config["shots"]:      # the config's validation checked that every shot has its source's entry
         if observed["source"] == "records":
             spec = observed["records"][shot]
+            where = f"record {spec['path']} (observed.records.{shot}.path)"
             rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
                          **record_features(spec["path"], extractor_settings(config, shot), shot,
                                            spec["time_column"], spec["velocity_column"])})
         else:
+            where = f"observed.features.{shot}"
             rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
                          **observed["features"][shot]})
+        box = velocity_box_m_s(config, shot)
+        if box is not None:        # a record of another shot: its plateau is another impact velocity's
+            check_plateau(rows[-1], box, f"shot {shot}: {where}", config["checks"]["plateau_vs_velocity"])
     return pd.DataFrame(rows)[["shot", "source", *COLUMNS]]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from shockcal.errors import ConfigError
-from shockcal.units import MM_TO_CM
+from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S
 
 AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
 
@@ -41,3 +41,11 @@ def input_names(config: dict) -> list[str]:
 def prior_bounds(config: dict) -> dict[str, tuple[float, float]]:
     """The prior box, input by input in config order: name -> (min, max) in the box's native units."""
     return {name: (box["min"], box["max"]) for name, box in config["inputs"].items()}
+
+
+def velocity_box_m_s(config: dict, shot: str) -> tuple[float, float] | None:
+    """The impact-velocity box of `shot` in m/s (its `velocity_input`'s box, converted from the input's
+    unit), or None when that unit is not a velocity unit shockcal knows (`VELOCITY_TO_M_S`)."""
+    box = config["inputs"][shot_config(config, shot)["velocity_input"]]
+    factor = VELOCITY_TO_M_S.get(str(box["unit"]).strip())
+    return None if factor is None else (box["min"] * factor, box["max"] * factor)

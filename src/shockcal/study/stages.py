@@ -39,7 +39,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "failure_budget": ("simulate.max_failed_fraction", "shots.{shot}.analysis"),
     # the measured features of every shot (from the records or the published values)
     "observed": ("observed.source", "observed.features", "observed.records", "features", "shots.*.analysis",
-                 "checks.observed_units"),
+                 "checks.observed_units", "checks.plateau_vs_velocity", "inputs", "shots.*.velocity_input"),
     # the emulator fit and its cross-validation
     "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", *_SHOT_MAPPING),
     # the emulator's predictions at a design's runs
@@ -47,12 +47,13 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # one calibration (single shot or joint)
     "calibrate": ("study.seed", "calibration.n_live", "calibration.n_eff", "calibration.draws",
                   "calibration.cube_power", "calibration.max_evaluations", "observed.sd_fraction",
-                  "checks.observed_units", "inputs"),
+                  "checks.observed_units", "checks.plateau_vs_velocity", "inputs", *_SHOT_MAPPING),
     # a batch of synthetic-truth trials
     "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
-                        "observed.sd_fraction", "checks.observed_units", "inputs"),
+                        "observed.sd_fraction", "checks.observed_units", "checks.plateau_vs_velocity", "inputs",
+                        *_SHOT_MAPPING),
     # the posterior rows run through the hydrocode for predictions
-    "predict": ("study.seed", "predict.n_posterior_runs", "inputs"),
+    "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
     "sensitivity": ("study.seed", "sensitivity", "inputs"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)

@@ -15,8 +15,9 @@ import yaml
 
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
-from shockcal.plausibility import check_observed
+from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import load_study_design
+from shockcal.study.config import velocity_box_m_s
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
@@ -27,12 +28,35 @@ def load_config(path: str | Path) -> dict:
     if not path.is_file():
         raise ConfigError(f"config file {path} does not exist")
     try:
-        config = yaml.safe_load(path.read_text())
+        text = path.read_text(encoding="utf-8-sig")
+        config = yaml.safe_load(text)
+        _check_repeated_keys(yaml.compose(text, Loader=yaml.SafeLoader), path)
     except yaml.YAMLError as exc:
-        raise ConfigError(f"config file {path} is not valid YAML: {exc}") from exc
+        reason = " ".join(str(exc).split())
+        raise ConfigError(f"config file {path} is not valid YAML: {reason}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"config file {path} is not UTF-8 text: {exc}") from None
     if not isinstance(config, dict):
         raise ConfigError(f"config file {path} must hold a mapping at the top level")
     return validate_config(config, source=str(path))
+
+
+def _check_repeated_keys(node, path, where: str = "") -> None:
+    """A key given twice in one mapping (two `104S:` under `shots:`) is a ConfigError naming both lines:
+    YAML loaders keep the last one silently."""
+    if isinstance(node, yaml.MappingNode):
+        seen = {}
+        for key, value in node.value:
+            name = key.value if isinstance(key, yaml.ScalarNode) else None
+            if name is not None and name in seen:
+                raise ConfigError(f"config file {path}: {where}{name}: given twice (lines {seen[name]} and "
+                                  f"{key.start_mark.line + 1}); YAML would keep only the last")
+            if name is not None:
+                seen[name] = key.start_mark.line + 1
+            _check_repeated_keys(value, path, f"{where}{name}." if name is not None else where)
+    elif isinstance(node, yaml.SequenceNode):
+        for item in node.value:
+            _check_repeated_keys(item, path, where)
 
 
 def validate_config(config: dict, source: str = "config") -> dict:
@@ -130,15 +154,68 @@ def check_semantics(config: dict, source: str = "config") -> None:
                 raise ConfigError(f"{source}: observed.{section}.{shot}: unknown shot; known shots are {sorted(config['shots'])}")
     for shot, features in observed["features"].items():
         check_observed(features, f"{source}: observed.features.{shot}", config["checks"]["observed_units"], ConfigError)
+    check_distinct(observed, source)
+    for shot, features in observed["features"].items():
+        box = velocity_box_m_s(config, shot)
+        if box is not None:
+            check_plateau(features, box, f"{source}: observed.features.{shot}",
+                          config["checks"]["plateau_vs_velocity"], ConfigError)
     for shot, record in observed["records"].items():
         if not Path(record["path"]).is_file():
             raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
+    for shot in config["shots"]:
+        check_window(config, shot, source)
     source_section = "records" if observed["source"] == "records" else "features"
     for shot in config["shots"]:
         if shot not in observed[source_section]:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
                               f"{'published' if source_section == 'records' else 'records'}")
+
+
+def check_distinct(observed: dict, source: str) -> None:
+    """Two shots with the same record file, or the same measured features, are a copy-paste slip (a
+    shot's own measurement would be calibrated against another's): a ConfigError naming both."""
+    seen: dict = {}
+    for shot, record in observed["records"].items():
+        key = Path(record["path"]).resolve()
+        if key in seen:
+            raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} is also the record of shot "
+                              f"{seen[key]} (observed.records.{seen[key]}.path); each shot has its own record")
+        seen[key] = shot
+    seen = {}
+    for shot, features in observed["features"].items():
+        key = tuple(sorted(features.items()))
+        if key in seen:
+            raise ConfigError(f"{source}: observed.features.{shot}: the same values as observed.features.{seen[key]}; "
+                              "each shot has its own measurement")
+        seen[key] = shot
+
+
+SHEAR_MODULUS_TO_MBAR = {"Mbar": 1.0, "GPa": 0.01, "kbar": 1e-3}
+
+
+def check_window(config: dict, shot: str, source: str) -> None:
+    """The analysis window of `shot` must end before the release from the flyer's back reaches the free
+    surface (`shockcal.plausibility.release_times_us`, with the config's material and plates, and the
+    largest shear modulus of the shot's prior box: the earliest release); a window reaching it would
+    read the release as part of the plateau. Shear-modulus inputs in a unit other than
+    SHEAR_MODULUS_TO_MBAR's are not checked."""
+    spec, material = config["shots"][shot], config["material"]
+    units = [str(config["inputs"][name]["unit"]).strip() for name in spec["shear_modulus_inputs"]]
+    if any(unit not in SHEAR_MODULUS_TO_MBAR for unit in units):
+        return
+    g_max = sum(config["inputs"][name]["max"] * SHEAR_MODULUS_TO_MBAR[unit]
+                for name, unit in zip(spec["shear_modulus_inputs"], units))
+    arrival, release = release_times_us(spec["flyer_mm"], spec["target_mm"], material["rho0_g_cc"],
+                                        material["eos"]["c1_Mbar"], g_max)
+    window = spec["analysis"]["window_after_arrival_us"]
+    if window >= release - arrival:
+        raise ConfigError(
+            f"{source}: shots.{shot}.analysis.window_after_arrival_us: {window:g} us reaches the release from the "
+            f"flyer's back, {release - arrival:.3g} us after the first arrival (first arrival {arrival:.3g} us after "
+            f"impact, release {release:.3g} us: flyer {spec['flyer_mm']:g} mm, target {spec['target_mm']:g} mm, "
+            f"the box's largest shear modulus {g_max * 100:.3g} GPa); end the window before it")
 
 
 def check_design_file(config: dict, source: str = "config") -> None:
