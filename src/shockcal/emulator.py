@@ -393,7 +393,8 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
         _check_training_inputs(table, input_map, label)
         settings = replace(spec.settings, seed=stream_seed(spec.settings.seed, "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
-                                 settings, switches=single_wave_switches(len(block_shots)))
+                                 settings, switches=single_wave_switches(len(block_shots)),
+                                 sd_groups=feature_groups(len(block_shots)))
         log.info("emulator %s: %d runs, %d inputs, %d of %d components, %s correlation", "+".join(block_shots),
                  len(table), len(input_map.names), len(model.gps), len(columns), settings.family)
         blocks.append(Block(input_map, block_shots, table["run"].to_numpy(), model))
@@ -406,6 +407,15 @@ def single_wave_switches(n_shots: int) -> list[Switch]:
     k = len(CALIBRATION_FEATURES)
     elastic, plastic = CALIBRATION_FEATURES.index("v_elastic"), CALIBRATION_FEATURES.index("v_plastic")
     return [Switch(k * i + elastic, k * i + plastic, list(range(k * i, k * (i + 1)))) for i in range(n_shots)]
+
+
+def feature_groups(n_shots: int) -> list[list[int]]:
+    """Groups of output columns sharing one smooth variance model (`shockcal.variance_model`): each
+    calibration feature across the shots (features in CALIBRATION_FEATURES order, shot after shot).
+    A feature's error grows in the same corners of the box in every shot (FLAG runs 0-499), and pooling
+    the shots thins the noise of log z^2; one model per output fitted worse (docs/emulator.md)."""
+    k = len(CALIBRATION_FEATURES)
+    return [[k * i + f for i in range(n_shots)] for f in range(k)]
 
 
 def rmse_table(cv: pd.DataFrame) -> pd.DataFrame:

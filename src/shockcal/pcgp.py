@@ -4,9 +4,10 @@
 column, projected on an orthogonal basis from the SVD of the standardized training outputs, and each
 basis weight gets its own GP (`shockcal.gp`) over inputs scaled to [0, 1]. Prediction returns the mean
 and covariance of the outputs, adding the covariance of what the truncated basis leaves out, with each
-output's sd scaled by a factor calibrated by K-fold, and an error model (`shockcal.error_model`)
-around them. Cross-validation: closed-form LOO (diagnostic), K-fold and the outer check (everything
-refitted). Saved as one .npz (arrays and a JSON header); no live object is pickled.
+output's sd scaled by a factor calibrated by K-fold (constant per output, or varying smoothly over the
+box: `shockcal.variance_model`), and an error model (`shockcal.error_model`) around them.
+Cross-validation: closed-form LOO (diagnostic), K-fold and the outer check (everything refitted).
+Saved as one .npz (arrays and a JSON header); no live object is pickled.
 
 This module knows nothing of shots or designs: the study's emulator (`shockcal.emulator`) maps design
 columns to its inputs.
@@ -30,8 +31,10 @@ from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.gp import GaussianProcess, Hyper
 from shockcal.io import atomic_path
+from shockcal.variance_model import VarianceModel
 
-FORMAT_VERSION = 4                  # 4: the error model (3 had no error tails, 2 the strain^n input only)
+FORMAT_VERSION = 5                  # 5: the smooth sd model (4 had constant sd factors only, 3 no error tails)
+SD_MODELS = ("constant", "smooth")
 Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
 SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
@@ -55,7 +58,11 @@ class Settings:
     cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
     switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
     error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
+    sd_model: str = "smooth"       # sd calibration: constant factors per output, or smooth over the box
 
+    def __post_init__(self):
+        if self.sd_model not in SD_MODELS:
+            raise InputError(f"emulator sd_model {self.sd_model!r}: one of {', '.join(SD_MODELS)}")
 
 
 @dataclass
@@ -119,7 +126,8 @@ class PCGPEmulator:
 
 
     def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings, sd_factor=None, switches=None, error: ErrorModel | None = None):
+                 settings: Settings, sd_factor=None, switches=None, error: ErrorModel | None = None,
+                 variance: VarianceModel | None = None, sd_groups=None):
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
         self.residual_cov = np.asarray(residual_cov)
@@ -128,6 +136,9 @@ class PCGPEmulator:
         # sd factors (2, F): row 0 in the usual regime, row 1 past a switch (see `switch_weight`)
         self.sd_factor = np.ones((2, len(self.mean))) if sd_factor is None else np.asarray(sd_factor, dtype=float)
         self.switches: list[Switch] = list(switches or [])
+        # with sd_model "smooth": the sd varies over the box by exp(g(x) / 2), g shared by each group's outputs
+        self.variance = variance
+        self.sd_groups: list[list[int]] = [list(g) for g in sd_groups] if sd_groups else [list(range(len(self.mean)))]
         self.kfold: HeldOut | None = None          # the K-fold of the sd calibration, kept for reporting
         self.error = error or ErrorModel()         # the error's distribution around (mean, covariance)
         self._input_names: list[str] | None = None
@@ -157,7 +168,8 @@ class PCGPEmulator:
 
     @classmethod
     def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None,
-            switches: list[Switch] | None = None, input_names: list[str] | None = None) -> PCGPEmulator:
+            switches: list[Switch] | None = None, input_names: list[str] | None = None,
+            sd_groups: list[list[int]] | None = None) -> PCGPEmulator:
         """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode (from
         `starts`, one per component, if given; else from `settings.n_starts` starts).
 
@@ -169,11 +181,17 @@ class PCGPEmulator:
             starts: hyperparameter starts, one per component (e.g. a previous fit's).
             switches: output regime switches that get sd factors of their own (`Switch`).
             input_names: the d inputs' names (default x0, x1, ...).
+            sd_groups: with `settings.sd_model == "smooth"`, groups of output columns that share one
+                variance model g (default: all outputs in one group).
 
         With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
         quantile of its K-fold |error| / sd over 1.645: one factor per feature, never per run, and
         a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
-        traces), when there are at least SWITCH_MIN_RUNS of them.
+        traces), when there are at least SWITCH_MIN_RUNS of them. With `settings.sd_model ==
+        "smooth"`, the K-fold's log z^2 is first fitted by a smooth variance model g over the box
+        (`shockcal.variance_model`), the sd is multiplied by exp(g(x) / 2), and the constant factors
+        are then fitted to the z values so rescaled: g gives the shape over the box, the factors the
+        level (and the switched regime's level).
 
         With `settings.error_tails == "student_t"`, the error model's (dof, scale) are fitted to
         the Mahalanobis distances of the same K-fold's errors (`shockcal.error_model`).
@@ -182,10 +200,12 @@ class PCGPEmulator:
         model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
         model.switches = list(switches or [])
         model._input_names = list(input_names) if input_names is not None else None
+        if sd_groups is not None:
+            model.sd_groups = [list(g) for g in sd_groups]
         if settings.calibrate_sd or settings.error_tails == "student_t":
             held, folds = model._kfold(settings.cv_folds, settings.seed)
             if settings.calibrate_sd:
-                model.sd_factor = _sd_factor(model, held, np.ones(len(held.rows), dtype=bool))
+                model.sd_factor, model.variance = _calibration(model, held, np.ones(len(held.rows), dtype=bool))
                 held = _cross_fitted(model, held, folds)
             model.kfold = held
             if settings.error_tails == "student_t":
@@ -240,7 +260,8 @@ class PCGPEmulator:
         w_mean, w_var = self._predict_weights(np.ascontiguousarray(x, dtype=float))
         z_cov = np.einsum("nj,jf,jg->nfg", w_var, self.basis, self.basis) + self.residual_cov
         mean = self.mean + (w_mean @ self.basis) * self.scale
-        sd_scale = self.scale * self.sd_factors(mean)                              # (N, F)
+        raw_sd = np.sqrt(np.einsum("nff->nf", z_cov)) * self.scale
+        sd_scale = self.scale * self.sd_factors(mean, x, raw_sd)                   # (N, F)
         return mean, z_cov * sd_scale[:, :, None] * sd_scale[:, None, :]
 
     def error_groups(self) -> list[tuple[np.ndarray, ErrorModel]]:
@@ -261,9 +282,12 @@ class PCGPEmulator:
                 weight[:, sw.affected] = step[:, None]
         return weight
 
-    def sd_factors(self, mean: np.ndarray) -> np.ndarray:
-        """(N, F) sd factors at predicted means, blending the usual and the switched regime's."""
-        return _blend(self.sd_factor, self.switch_weight(mean))
+    def sd_factors(self, mean: np.ndarray, x: np.ndarray, raw_sd: np.ndarray) -> np.ndarray:
+        """(N, F) sd factors: the constant factors at the predicted means (N, F), blending the usual
+        and the switched regime's, times the smooth model's exp(g / 2) at scaled inputs x (N, d) and
+        the uncalibrated sd raw_sd (N, F, output units) when there is one."""
+        factors = _blend(self.sd_factor, self.switch_weight(mean))
+        return factors if self.variance is None else factors * self.variance.sd_factors(x, raw_sd)
 
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance (N, p) of each basis weight at scaled inputs x, on `settings.n_jobs`
@@ -290,8 +314,9 @@ class PCGPEmulator:
             w_mean[:, j], w_var[:, j] = gp.loo()
         z_var = w_var @ self.basis**2 + np.diag(self.residual_cov)
         mean = self.mean + (w_mean @ self.basis) * self.scale
+        raw_sd = np.sqrt(z_var) * self.scale
         return HeldOut("loo_closed_form", np.arange(len(self.y_train)),
-                       mean, np.sqrt(z_var) * self.scale * self.sd_factors(mean))
+                       mean, raw_sd * self.sd_factors(mean, self.x_train, raw_sd))
 
     def cross_validate(self, k: int = 10, seed: int | None = None) -> HeldOut:
         """K-fold (seeded folds): standardization, basis and hyperparameters refitted on each fold.
@@ -323,7 +348,7 @@ class PCGPEmulator:
             empty = np.empty((0, self.y_train.shape[1]))
             return HeldOut("outer", np.empty(0, dtype=int), empty, empty)
         held = self._held_out("outer", [np.flatnonzero(~inner)], [np.flatnonzero(inner)])
-        return held.scaled(self.sd_factors(held.mean))
+        return held.scaled(self.sd_factors(held.mean, self.x_train[held.rows], held.sd))
 
     def _held_out(self, scheme, tests, trains) -> HeldOut:
         starts = [gp.hyper for gp in self.gps] if self.settings.cv_warm_start else None
@@ -341,12 +366,14 @@ class PCGPEmulator:
     def to_arrays(self, prefix: str = "") -> dict:
         arrays = {"lower": self.lower, "upper": self.upper, "mean": self.mean, "scale": self.scale,
                   "basis": self.basis, "residual_cov": self.residual_cov, "x_train": self.x_train,
-                  "y_train": self.y_train, "sd_factor": self.sd_factor}
+                  "y_train": self.y_train, "sd_factor": self.sd_factor,
+                  **(self.variance.to_arrays() if self.variance is not None else {})}
         return {f"{prefix}{k}": v for k, v in arrays.items()}
 
     def to_json(self) -> dict:
         return {"settings": asdict(self.settings), "switches": [asdict(sw) for sw in self.switches],
-                "error": self.error.to_json(),
+                "error": self.error.to_json(), "sd_groups": self.sd_groups,
+                "variance": None if self.variance is None else self.variance.to_json(),
                 "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
                                      "lambda_n": g.hyper.lambda_n, "mean": g.hyper.mean} for g in self.gps]}
 
@@ -356,7 +383,9 @@ class PCGPEmulator:
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
         return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
                    arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]],
-                   ErrorModel.from_json(meta["error"]))
+                   ErrorModel.from_json(meta["error"]),
+                   None if meta["variance"] is None else VarianceModel.from_saved(meta["variance"], arrays, prefix),
+                   meta["sd_groups"])
 
     def save(self, path) -> Path:
         """One .npz file: the arrays plus a JSON header (format, version, settings, hyperparameters)."""
@@ -372,8 +401,23 @@ class PCGPEmulator:
             arrays = dict(npz)
         header = json.loads(str(arrays.pop("header")))
         if header.get("format") != "shockcal-pcgp" or header.get("version") != FORMAT_VERSION:
-            raise InputError(f"{path}: not a shockcal PC-GP emulator of version {FORMAT_VERSION}")
+            raise InputError(f"{path}: format {header.get('format')!r} version {header.get('version')}; this "
+                             f"shockcal reads PC-GP emulators of version {FORMAT_VERSION} (5: the smooth sd "
+                             f"model): refit it")
         return cls.from_saved(header, arrays)
+
+
+def _calibration(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> tuple[np.ndarray, VarianceModel | None]:
+    """The sd calibration from the rows `use` of a held-out set with the fold models' own sd: with
+    sd_model "smooth", the variance model g fitted to their z values, then the (2, F) constant
+    factors (`_sd_factor`) of the z values divided by exp(g / 2); with "constant", the factors alone."""
+    if model.settings.sd_model != "smooth":
+        return _sd_factor(model, held, use), None
+    x, sd = model.x_train[held.rows[use]], held.sd[use]
+    variance = VarianceModel.fit(x, (held.mean[use] - model.y_train[held.rows[use]]) / sd, sd, model.sd_groups)
+    smooth = np.ones_like(held.sd)
+    smooth[use] = variance.sd_factors(x, sd)
+    return _sd_factor(model, held.scaled(smooth), use), variance
 
 
 def _sd_factor(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> np.ndarray:
@@ -395,12 +439,16 @@ def _blend(factors: np.ndarray, weight: np.ndarray) -> np.ndarray:
 
 
 def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
-    """K-fold sd scaled, fold by fold, by the factors of the other folds (an honest coverage)."""
+    """K-fold sd scaled, fold by fold, by the calibration of the other folds (an honest coverage:
+    nested, the variance model and the factors never see the fold they scale)."""
     fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
     factors = np.empty_like(held.sd)
     for j in range(len(folds)):
         here = fold_of == j
-        factors[here] = _blend(_sd_factor(model, held, ~here), model.switch_weight(held.mean[here]))
+        constant, variance = _calibration(model, held, ~here)
+        factors[here] = _blend(constant, model.switch_weight(held.mean[here]))
+        if variance is not None:
+            factors[here] *= variance.sd_factors(model.x_train[held.rows[here]], held.sd[here])
     return held.scaled(factors)
 
 
