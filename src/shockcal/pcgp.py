@@ -58,7 +58,7 @@ class Settings:
     cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
     switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
     error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
-    sd_model: str = "smooth"       # sd calibration: constant factors per output, or smooth over the box
+    sd_model: str = "constant"     # sd calibration: constant factors per output, or smooth over the box
 
     def __post_init__(self):
         if self.sd_model not in SD_MODELS:
