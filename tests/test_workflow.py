@@ -257,7 +257,7 @@ def test_a_shot_added_by_config_alone_runs_only_its_simulations(study, tmp_path)
     quick = load_config(REPO / "config" / "config.yaml")
     shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4", shear_modulus_inputs=["G1", "Delta4"])
     more = overlay(tmp_path / "shot.yaml", inputs={"V4": quick["inputs"]["V3"], "Delta4": quick["inputs"]["Delta3"]},
-                   shots={"107S": shot}, observed={"records": {"107S": dict(quick["observed"]["records"]["106S"])}})
+                   shots={"107S": shot}, observed={"records": {"107S": _own_record(quick, tmp_path)}})
     jobs = pending_jobs(config, more)
     assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
 
