@@ -32,7 +32,9 @@ The material, strength and numerics parameters travel as named tuples in code un
 take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
 so its nodes keep their initial velocities bit for bit, and the active window grows by one node
-when the stress of the cell beyond it becomes non-zero.
+when the stress of the cell beyond it becomes non-zero. (In a hot shot a cell at rest evaluates its
+EOS to a rounding residual, |P| < 1e-15 Mbar, so the window may run ahead of the wave: the same
+physics, a little more work.)
 """
 
 from __future__ import annotations
