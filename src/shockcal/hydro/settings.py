@@ -7,10 +7,12 @@ These are what `run_shot` takes; each converts itself to the kernel's named tupl
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from shockcal.hydro.solver import Material, Numerics
-from shockcal.units import J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
+from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
+from shockcal.hydro.solver import InitialState, Material, Numerics
+from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 
 @dataclass(frozen=True)
@@ -18,14 +20,19 @@ class Geometry:
     """A symmetric plate impact.
 
     Args:
-        flyer_mm: flyer plate thickness (mm).
-        target_mm: target plate thickness (mm); the measured free surface is its back.
+        flyer_mm: flyer plate thickness (mm), at the shot's initial temperature (the hot thickness of a
+            heated shot).
+        target_mm: target plate thickness (mm), likewise; the measured free surface is its back.
         end_us: simulated time after impact (us).
+        initial_temperature_K: temperature of both plates before impact (K); None: the material's
+            T_ref_K (a room-temperature shot). Hotter plates start expanded, at zero pressure
+            (`MaterialProperties.initial_state`).
     """
 
     flyer_mm: float
     target_mm: float
     end_us: float
+    initial_temperature_K: float | None = None
 
 
 @dataclass(frozen=True)
@@ -59,6 +66,28 @@ class MaterialProperties:
 
     def rate_ref_per_us(self) -> float:
         return self.strain_rate_ref_per_s * PER_S_TO_PER_US
+
+    def initial_state(self, temperature_K: float | None = None) -> InitialState:
+        """The material at rest and zero pressure at `temperature_K` (K; None: T_ref_K), in code units:
+        E0 = cv (T0 - T_ref) (the code's T = T_ref + E / cv), rho = rho0 (1 + mu0) with mu0 the root of
+        c1 mu0 + c2 mu0^2 + c3 mu0^3 + gamma0 rho0 E0 = 0 (`eos.zero_pressure_compression`). At T_ref
+        exactly: rho0 and E0 = 0, bit for bit."""
+        T0 = self.T_ref_K if temperature_K is None else float(temperature_K)
+        E0 = self.cv_J_per_kg_K * J_PER_KG_TO_CODE * (T0 - self.T_ref_K)
+        mu0 = zero_pressure_compression(E0, self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0)
+        return InitialState(self.rho0_g_cc * (1.0 + mu0), E0)
+
+    def initial_density_g_cc(self, temperature_K: float | None = None) -> float:
+        """Density at rest and zero pressure at `temperature_K` (K; None: T_ref_K), g/cc."""
+        return self.initial_state(temperature_K).rho
+
+    def bulk_sound_speed_m_s(self, temperature_K: float | None = None) -> float:
+        """Bulk sound speed sqrt((dP/drho)_s) of this EOS at rest and zero pressure at `temperature_K`
+        (K; None: T_ref_K), m/s."""
+        mu0 = self.initial_state(temperature_K).rho / self.rho0_g_cc - 1.0
+        c_sq = bulk_sound_speed_sq(mu0, 0.0, 1.0, self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar,
+                                   self.gamma0)
+        return math.sqrt(c_sq) * CM_US_TO_M_S
 
 
 # Al-5083-H131, the paper's Table II (Walters et al. 2018); T_melt from SPEC section 2 (not in the paper).

@@ -32,7 +32,9 @@ The material, strength and numerics parameters travel as named tuples in code un
 take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
 so its nodes keep their initial velocities bit for bit, and the active window grows by one node
-when the stress of the cell beyond it becomes non-zero.
+when the stress of the cell beyond it becomes non-zero. (In a hot shot a cell at rest evaluates its
+EOS to a rounding residual, |P| < 1e-15 Mbar, so the window may run ahead of the wave: the same
+physics, a little more work.)
 """
 
 from __future__ import annotations
@@ -74,6 +76,15 @@ class Material(NamedTuple):
     T_ref: float           # K
     T_melt: float          # K
     cv: float              # (cm/us)^2 / K
+
+
+class InitialState(NamedTuple):
+    """Both plates before impact: at rest, at zero pressure, at the shot's initial temperature (code
+    units). At T_ref: rho = rho0, E = 0; hotter, E = cv (T0 - T_ref) and rho solves P(rho, E) = 0
+    (`MaterialProperties.initial_state`)."""
+
+    rho: float             # g/cc
+    E: float               # specific internal energy, (cm/us)^2
 
 
 class Strength(NamedTuple):
@@ -143,16 +154,19 @@ class Cells(NamedTuple):
 
 
 @njit(cache=True, error_model="numpy")
-def initial_mesh(nf, nt, dx, velocity, strength, material):
-    """Flyer (cells 0..nf-1) at `velocity` against a target at rest (cells nf+1..N), touching."""
+def initial_mesh(nf, nt, dx, velocity, initial, strength, material):
+    """Flyer (cells 0..nf-1) at `velocity` against a target at rest (cells nf+1..N), touching; every
+    cell of length dx at the initial state's density and energy, at zero pressure and stress."""
     N = nf + nt
     gap = nf
-    mass = np.full(N + 1, material.rho0 * dx)
+    mass = np.full(N + 1, initial.rho * dx)
     mass[gap] = 0.0
     length = np.full(N + 1, dx)
     length[gap] = 0.0
+    E = np.full(N + 1, initial.E)
+    E[gap] = 0.0
     hard = np.full(N + 1, hardening(strength.A, strength.B, strength.n, 0.0))
-    cells = Cells(mass, length, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
+    cells = Cells(mass, length, E, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
                   np.zeros(N + 1), hard, np.zeros(N + 1), np.zeros(N + 1), np.full(N + 1, np.inf))
     u = np.zeros(N + 2)
     u[: nf + 1] = velocity
@@ -358,7 +372,7 @@ def grow_window(sigma, lo, hi):
 
 
 @njit(cache=True, error_model="numpy")
-def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
+def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out):
     """Run to t_out[-1] (us): a `KernelResult` (free-surface velocity and total energy at t_out, status,
     failed cell and time, steps, the maxima over the target's cells).
 
@@ -366,12 +380,13 @@ def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
         nf, nt: cells across the flyer and the target.
         dx: cell size (cm).
         velocity: impact velocity of the flyer (cm/us).
+        initial: `InitialState` of both plates (g/cc, (cm/us)^2).
         strength: `Strength` (Mbar, -, 1/us).
         material: `Material` (code units).
         numerics: `Numerics` (artificial viscosity, CFL, time steps in us).
         t_out: output times (us), t_out[0] = 0.
     """
-    nodes, cells = initial_mesh(nf, nt, dx, velocity, strength, material)
+    nodes, cells = initial_mesh(nf, nt, dx, velocity, initial, strength, material)
     u = nodes.u
     N = nf + nt
     gap = nf
@@ -380,7 +395,7 @@ def simulate(nf, nt, dx, velocity, strength, material, numerics, t_out):
     v_out = np.zeros(n_out)
     energy_out = np.zeros(n_out)
     energy_out[0] = total_energy(nodes, cells)
-    peaks = np.array([0.0, material.T_ref, 0.0])
+    peaks = np.array([0.0, material.T_ref + initial.E / material.cv, 0.0])
     k_out = 1
     t = 0.0
     dt = numerics.dt_initial

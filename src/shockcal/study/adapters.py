@@ -55,9 +55,12 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
                  ) -> tuple[Geometry, MaterialProperties, HydroSettings]:
     """`run_shot`'s inputs for a shot besides its parameters: (Geometry, MaterialProperties,
     HydroSettings). `spec` is the shot's config section (`shot_config(config, shot)`); `end_us` (us)
-    defaults to the config's end time (`end_time_us`)."""
+    defaults to the config's end time (`end_time_us`); the shot's `initial_temperature_K` (K), absent or
+    null, is the material's T_ref_K."""
     end_us = end_time_us(config, spec) if end_us is None else end_us
-    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us)),
+    temperature = spec.get("initial_temperature_K")
+    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us),
+                     None if temperature is None else float(temperature)),
             material_properties(config), hydro_settings(config))
 
 

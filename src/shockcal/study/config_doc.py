@@ -159,7 +159,8 @@ def _resolve(root: dict, schema: dict) -> dict:
 
 def _overlaps(path: tuple[str, ...], declared: list[str]) -> bool:
     """Whether a key path and a declared path (STAGE_KEYS syntax) share a key: one is the other's prefix,
-    segment by segment, a placeholder or wildcard matching any key."""
+    segment by segment, a placeholder or wildcard matching any key; an optional key's `?` is dropped."""
+    declared = [*declared[:-1], declared[-1].removesuffix("?")] if declared else declared
     return all(k == d or d in WILDCARDS or k.startswith("<") for k, d in zip(path, declared))
 
 

@@ -10,7 +10,9 @@ serves both channels a stage gets its settings through:
   the tests) instead of silently missing from the rerun triggers.
 
 Path segments: a key; `*` every key at that level (e.g. every shot); `{shot}` the shot the job
-works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`).
+works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`). A trailing `?`
+marks an optional key, sliced only when the config gives it: a key whose absence is its default (a
+shot's `initial_temperature_K`), so that declaring it reruns none of the jobs of configs without it.
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
 from shockcal.study.validate import load_config
 
-_SHOT_GEOMETRY = ("flyer_mm", "target_mm", "velocity_input", "shear_modulus_inputs")
+_SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
@@ -83,7 +85,10 @@ def config_slice(config: dict, paths: Iterable[str], shot: str | None = None, la
     `label` names the declaration in errors."""
     sliced: dict = {}
     for path in paths:
-        for keys in _expand(config, path.split("."), shot, label):
+        optional = path.endswith("?")
+        for keys in _expand(config, path.removesuffix("?").split("."), shot, label):
+            if optional and not _present(config, keys):
+                continue
             _copy(config, keys, sliced, f"{label}: {path}")
     return sliced
 
@@ -120,6 +125,16 @@ def _node(config: dict, keys: list[str], declared: str):
             raise KeyError(f"config key {'.'.join(keys)} (declared by stage {declared}) is not in the config")
         node = node[key]
     return node
+
+
+def _present(config: dict, keys: list[str]) -> bool:
+    """Whether the key path `keys` is in `config`."""
+    node = config
+    for key in keys:
+        if not isinstance(node, dict) or key not in node:
+            return False
+        node = node[key]
+    return True
 
 
 def _copy(config: dict, keys: list[str], sliced: dict, declared: str) -> None:

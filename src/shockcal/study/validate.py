@@ -138,6 +138,8 @@ def check_semantics(config: dict, source: str = "config") -> None:
         for key, name in mapped:
             if name not in inputs:
                 raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
+    for shot, spec in config["shots"].items():
+        check_initial_temperature(spec, config["material"], f"{source}: shots.{shot}.initial_temperature_K")
     for name in config["calibration"]["cube_power"]:
         if name not in inputs:
             raise ConfigError(f"{source}: calibration.cube_power.{name}: not one of the inputs {sorted(inputs)}")
@@ -171,6 +173,15 @@ def check_semantics(config: dict, source: str = "config") -> None:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
                               f"{'published' if source_section == 'records' else 'records'}")
+
+
+def check_initial_temperature(spec: dict, material: dict, where: str) -> None:
+    """A shot's initial temperature (K) must lie below the material's melting temperature: the
+    Johnson-Cook strength vanishes at T* = 1 and the plates would start molten."""
+    temperature = spec.get("initial_temperature_K")
+    if temperature is not None and not temperature < material["T_melt_K"]:
+        raise ConfigError(f"{where}: {temperature:g} K is at or above material.T_melt_K ({material['T_melt_K']:g} K); "
+                          "a shot starts solid, below the melting temperature")
 
 
 def check_distinct(observed: dict, source: str) -> None:
