@@ -292,8 +292,11 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
 # -45 and -38 ns). Cases beyond the worst case keep that bound and are xfail with the measured
 # difference. With EM run to convergence from fixed starts, jump-off and elastic times agree within
 # 1.1 ns in every shot (the seeded, default-tolerance fit was 24-29 ns off in 105S and 106S).
+# 104S's time bound was 4 ns (t_slope1 -2.09 ns with the 10,000-sample fit); the exact-CDF fit
+# (2026-11-25) reads t_slope1 4.9 ns earlier, -6.97 ns: its optimum has a small component at the foot
+# of the plastic rise and a higher likelihood under the trace's CDF (-0.60191 against -0.60250).
 WORST_CASE = (3.0, 0.010)  # m/s, us
-BOUNDS = {"104S": (2.1, 0.004), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
+BOUNDS = {"104S": (2.1, 0.0071), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
 BEYOND = {  # measured (ours - published), m/s
     ("105S", "v_plastic"): 7.11, ("106S", "v_plastic"): 3.21, ("106S", "v_slope1"): 4.74,
 }

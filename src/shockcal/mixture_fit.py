@@ -108,12 +108,14 @@ def em_step(x, w, weights, means, variances, floor):
     for i in range(x.size):
         top, norm = _component_densities(x[i], log_norm, means, inverse_variances, density)
         loglik += w[i] * (top + np.log(norm))
+        scale = w[i] / norm
         for j in range(k):
-            r = w[i] * density[j] / norm
-            d = x[i] - means[j]
-            mass[j] += r
-            first[j] += r * d
-            second[j] += r * d * d
+            if density[j] > 0.0:
+                r = scale * density[j]
+                d = x[i] - means[j]
+                mass[j] += r
+                first[j] += r * d
+                second[j] += r * d * d
     for j in range(k):
         m = mass[j] + _TINY
         shift = first[j] / m
