@@ -292,11 +292,8 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
 # -45 and -38 ns). Cases beyond the worst case keep that bound and are xfail with the measured
 # difference. With EM run to convergence from fixed starts, jump-off and elastic times agree within
 # 1.1 ns in every shot (the seeded, default-tolerance fit was 24-29 ns off in 105S and 106S).
-# 104S's time bound was 4 ns (t_slope1 -2.09 ns with the 10,000-sample fit); the exact-CDF fit
-# (2026-11-25) reads t_slope1 4.9 ns earlier, -6.97 ns: its optimum has a small component at the foot
-# of the plastic rise and a higher likelihood under the trace's CDF (-0.60191 against -0.60250).
 WORST_CASE = (3.0, 0.010)  # m/s, us
-BOUNDS = {"104S": (2.1, 0.0071), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
+BOUNDS = {"104S": (2.1, 0.004), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
 BEYOND = {  # measured (ours - published), m/s
     ("105S", "v_plastic"): 7.11, ("106S", "v_plastic"): 3.21, ("106S", "v_slope1"): 4.74,
 }
@@ -349,15 +346,16 @@ def two_gaussian_cdf():
 
 def test_exact_fit_recovers_a_known_two_component_mixture_and_agrees_with_many_pit_samples():
     y = two_gaussian_cdf()
-    exact = fit_mixture_exact(GRID, y, 2, n_samples=10**12)          # no tail left out
+    n = 100_000
+    rising = np.diff(y, prepend=-1.0) > 0
+    samples = np.interp((np.arange(n) + 0.5) / n, y[rising], GRID[rising])
+    exact = fit_mixture_exact(GRID, y, samples, 2)
     order = np.argsort(exact.means)
     np.testing.assert_allclose(exact.weights[order], TRUE_WEIGHTS, atol=1e-8)
     np.testing.assert_allclose(exact.means[order], TRUE_MEANS, atol=1e-8)
     inflation = exact.sds[order] - TRUE_SDS
     assert np.all(inflation >= 0) and np.all(inflation <= 0.0005**2 / (6 * TRUE_SDS)), inflation
-    n = 100_000
-    rising = np.diff(y, prepend=-1.0) > 0
-    pit = fit_mixture(np.interp((np.arange(n) + 0.5) / n, y[rising], GRID[rising]), 2)
+    pit = fit_mixture(samples, 2)
     pit_order = np.argsort(pit.means)
     np.testing.assert_allclose(exact.weights[order], pit.weights[pit_order], atol=1e-6)
     np.testing.assert_allclose(exact.means[order], pit.means[pit_order], atol=1e-6)

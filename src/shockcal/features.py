@@ -159,7 +159,7 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
     n = settings.n_samples
     samples = np.interp((np.arange(n) + 0.5) / n, y[rising], tw[rising])
     if method == "exact":
-        mixture = fit_mixture_exact(tw, y, settings.n_components, settings.n_samples)
+        mixture = fit_mixture_exact(tw, y, samples, settings.n_components)
     elif method == "pit":
         mixture = fit_mixture(samples, settings.n_components)
     else:
@@ -228,16 +228,16 @@ def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
     return Mixture(best.weights_, centre + spread * best.means_.ravel(), spread * np.sqrt(best.covariances_.ravel()))
 
 
-def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, n_components: int, n_samples: int) -> Mixture:
+def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, samples: np.ndarray, n_components: int) -> Mixture:
     """The EM fit of highest expected log-likelihood under the piecewise-linear CDF the PIT samples are
-    drawn from (`shockcal.mixture_fit`): the limit of infinitely many stratified samples over the
-    levels the n_samples cover, 1/(2 n_samples) to 1 - 1/(2 n_samples) (the far tails, which the
-    samples never reach, are left out: a Gaussian fit is not robust to them). `MIXTURE_STARTS`
-    deterministic starts; the tolerance and variance floor of `fit_mixture`, on the standardized scale."""
+    drawn from (`shockcal.mixture_fit`): the limit of `fit_mixture` as the number of samples grows. The
+    same starts (scikit-learn's, made from the samples), the same EM steps and stopping rule
+    (`MIXTURE_TOL`), the same variance floor, on the standardized scale."""
     from shockcal.mixture_fit import fit_piecewise_linear_cdf
 
     (weights, means, sds), _ = fit_piecewise_linear_cdf(t_window, cdf_window, n_components, MIXTURE_STARTS,
-                                                        MIXTURE_TOL, MIXTURE_MAX_ITER, trim=0.5 / n_samples)
+                                                        MIXTURE_TOL, MIXTURE_MAX_ITER, starts=samples,
+                                                        accelerate=False)
     return Mixture(weights, means, sds)
 
 

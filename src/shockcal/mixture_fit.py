@@ -23,6 +23,8 @@ node's mass, accelerated by SQUAREM with plain EM's stopping rule (`squarem`).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -34,18 +36,14 @@ SETTLED = 1e-3               # plain EM steps until one gains less than this (sc
 _TINY = 10 * np.finfo(float).eps   # scikit-learn's guard against an empty component
 
 
-def uniform_pieces(t: np.ndarray, y: np.ndarray, trim: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def uniform_pieces(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The CDF's uniform pieces: (left, right, mass), between consecutive points where y strictly
     increases (the pairs the PIT inverse interpolates); flat stretches carry no piece of their own.
-    With `trim` > 0, only the levels trim <= y <= 1 - trim: the range the stratified PIT samples
-    cover, the first at u = trim = 1/(2N)."""
+    A trace that starts above its minimum (a noisy record: y[0] > 0) puts the levels u < y[0] at the
+    window's start (np.interp clamps): a first piece of zero width carries that mass."""
     rising = np.diff(y, prepend=-np.inf) > 0
     tr, yr = t[rising], y[rising]
-    if trim > 0:
-        inside = (yr > trim) & (yr < 1 - trim)
-        tr = np.concatenate((np.interp([trim], yr, tr), tr[inside], np.interp([1 - trim], yr, tr)))
-        yr = np.concatenate(([trim], yr[inside], [1 - trim]))
-    return tr[:-1], tr[1:], np.diff(yr)
+    return np.r_[tr[0], tr[:-1]], np.r_[tr[0], tr[1:]], np.r_[yr[0], np.diff(yr)]
 
 
 def quadrature_nodes(left, right, mass, width: float, order: int):
@@ -237,16 +235,43 @@ def deterministic_starts(x, w, level, k: int, count: int):
     return starts
 
 
+@functools.cache
+def _threadpools():
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()      # 3 ms to find the thread pools: once a process
+
+
+def _one_openmp_thread():
+    return _threadpools().limit(limits=1, user_api="openmp")
+
+
+def kmeans_starts(z, k: int, count: int):
+    """scikit-learn's starts of the old fit on the (standardized) PIT samples z, as `GaussianMixture`
+    makes them: the M-step of k-means labels (n_init 1, random_state 0, 1, ...), the first with its
+    means replaced by the samples' quantiles (i + 1/2)/k. Seeded, so deterministic."""
+    from sklearn.cluster import KMeans
+
+    starts = []
+    with _one_openmp_thread():     # k-means in 1-D: OpenMP threads cost more than they save (5-10x, loaded)
+        for seed in range(max(count - 1, 1)):
+            labels = KMeans(n_clusters=k, n_init=1, random_state=seed).fit(z[:, None]).labels_
+            starts.append(hard_start(z, np.full(z.size, 1.0 / z.size), labels, k))
+    weights, _, variances = starts[0]
+    return [(weights, np.quantile(z, (np.arange(k) + 0.5) / k), variances), *starts][:count]
+
+
 def fit_piecewise_linear_cdf(t, y, n_components: int, n_starts: int, tol: float, max_iter: int, starts=None,
-                             accelerate: bool = True, trim: float = 0.0):
+                             accelerate: bool = True):
     """The Gaussian mixture of highest expected log-likelihood under the CDF y(t) (monotone, 0 to 1)
-    over `n_starts` deterministic starts (or the given `starts`: (weights, means, variances) on the
-    standardized scale), each run to convergence on the standardized scale by `squarem` (or plain
+    over `n_starts` starts: `deterministic_starts` when `starts` is None, `kmeans_starts` when it is an
+    array of PIT samples (in t's units), or the given list of (weights, means, variances) on the
+    standardized scale; each run to convergence on the standardized scale by `squarem` (or plain
     `em` when not `accelerate`; the same stopping rule, 1.5-3 times the EM steps).
 
     Returns (weights, means, sds) in t's units and a dict of diagnostics (standardization, nodes,
     per-start log-likelihood and iterations)."""
-    left, right, mass = uniform_pieces(np.asarray(t, float), np.asarray(y, float), trim)
+    left, right, mass = uniform_pieces(np.asarray(t, float), np.asarray(y, float))
     keep = mass > 0
     left, right, mass = left[keep], right[keep], mass[keep] / mass[keep].sum()
     centre = float(np.sum(mass * (left + right) / 2))                      # exact moments of the density
@@ -255,6 +280,8 @@ def fit_piecewise_linear_cdf(t, y, n_components: int, n_starts: int, tol: float,
                                         GAUSS_LEGENDRE_NODES)
     if starts is None:
         starts = deterministic_starts(x, w, level, n_components, n_starts)
+    elif not isinstance(starts, list):             # PIT samples: scikit-learn's k-means starts
+        starts = kmeans_starts((np.asarray(starts, float) - centre) / spread, n_components, n_starts)
     best, best_score, runs = None, -np.inf, []
     for start in starts:
         weights, means, variances = (np.array(p, dtype=float) for p in start)
