@@ -4,9 +4,9 @@ The extractor reads the standardized, monotone trace y(t) as a CDF. The SPEC dra
 transform (PIT) samples from it, t = y^-1(u), with the inverse the linear interpolation of the (y, t)
 pairs where y strictly increases, and fits the mixture to the samples. That distribution is known
 exactly: between consecutive such pairs (t_i, y_i), (t_i+1, y_i+1) it is uniform with mass
-y_i+1 - y_i. This module fits the mixture to it directly, which is the fit to infinitely many PIT
-samples: EM maximizes the expected log-likelihood  L = integral p(t) log f(t) dt  of the mixture f
-under that density p.
+y_i+1 - y_i (and the levels below y_0 sit at t_0). This module fits the mixture to it directly, the
+fit to infinitely many PIT samples: EM on the expected log-likelihood  L = integral p(t) log f(t) dt
+of the mixture f under that density p.
 
 The E- and M-steps need integrals of r_k(t) (1, t, t^2) p(t) over each uniform piece, with the
 responsibility r_k = pi_k N(t; mu_k, s_k^2) / f(t). They have no closed form (a ratio of Gaussians),
@@ -15,10 +15,13 @@ so each piece is integrated by 2-point Gauss-Legendre quadrature, exact for poly
 (1/64 of the distribution's sd: 1.6-3 ns on our traces, whose grid is 0.5 ns; only the stretches
 where the monotone trace is flat between two rises are that wide) are first cut into equal parts.
 Against 8 nodes on parts of 1/512 sd, the features of 30 hydrocode traces agree to 1e-2 ns or m/s
-(median 1e-5) with EM run to 1e-9 (docs/journal/2026-11-25-extractor-exact-cdf.md).
+(median 1e-5) with EM run to 1e-9 (docs/journal/2026-11-25-extractor-exact-cdf.md). EM then runs on
+the weighted nodes: the updates of EM on samples, each sample's 1/N replaced by the node's mass.
 
-EM then runs on the weighted nodes: the updates of EM on samples, each sample's 1/N replaced by the
-node's mass, accelerated by SQUAREM with plain EM's stopping rule (`squarem`).
+At the extractor's tolerance (1e-5 on L) EM stops on a slope of the likelihood, 0.1-3 ns short of
+its optimum: the features depend on EM's path, so the extractor keeps the old path (`kmeans_starts`,
+plain `em`). `deterministic_starts` and `squarem` (SQUAREM acceleration) are 1.5-2 times faster but
+take other paths (features 0.1-1 ns apart, other optima in a third of the traces); measured, not used.
 """
 
 from __future__ import annotations
@@ -262,12 +265,12 @@ def kmeans_starts(z, k: int, count: int):
 
 
 def fit_piecewise_linear_cdf(t, y, n_components: int, n_starts: int, tol: float, max_iter: int, starts=None,
-                             accelerate: bool = True):
+                             accelerate: bool = False):
     """The Gaussian mixture of highest expected log-likelihood under the CDF y(t) (monotone, 0 to 1)
     over `n_starts` starts: `deterministic_starts` when `starts` is None, `kmeans_starts` when it is an
     array of PIT samples (in t's units), or the given list of (weights, means, variances) on the
-    standardized scale; each run to convergence on the standardized scale by `squarem` (or plain
-    `em` when not `accelerate`; the same stopping rule, 1.5-3 times the EM steps).
+    standardized scale; each run to convergence on the standardized scale by plain `em` (by `squarem`
+    when `accelerate`: the same stopping rule, about 0.6 times the EM steps, another path).
 
     Returns (weights, means, sds) in t's units and a dict of diagnostics (standardization, nodes,
     per-start log-likelihood and iterations)."""
