@@ -15,10 +15,14 @@
    as a CDF; 10,000 samples are drawn by the probability integral transform: stratified uniform
    draws u_i = (i + 1/2)/N (no random numbers) mapped through the inverse CDF, linear interpolation
    of (y, t). The samples move smoothly with the trace, so neighbouring runs get neighbouring samples.
-4. A k = 5 Gaussian mixture (scikit-learn) is fitted by EM from `MIXTURE_STARTS` fixed starts (means
+   Their distribution is known exactly: uniform between consecutive (t, y) pairs where y rises.
+4. A k = 5 Gaussian mixture is fitted by EM to that exact distribution, the limit of infinitely many
+   samples (`fit_mixture_exact`, `shockcal.mixture_fit`: Gauss-Legendre quadrature over its uniform
+   pieces), from `MIXTURE_STARTS` fixed starts made from the samples as scikit-learn made them (means
    at the samples' k quantiles, then k-means starts seeded 0, 1, ...), each run to convergence
    (`MIXTURE_TOL`, far below scikit-learn's default 1e-3, which stops on a plateau of the
-   likelihood); the start of highest likelihood is kept. The features are a deterministic function of
+   likelihood); the start of highest likelihood is kept. `extract(..., method="pit")` keeps the
+   fit to the samples themselves (`fit_mixture`, scikit-learn), 30-90 times slower. The features are a deterministic function of
    the trace (no seed); a perturbation of 1e-6 of the rise moves them by 0.005 m/s or ns (median over
    hydrocode traces), more only where two EM optima nearly tie (docs/features.md, "Stability").
    Components with mu + 2 sigma < c,
@@ -140,13 +144,17 @@ class ExtractorSettings:
     n_samples: int = 10000
 
 
-def extract(t, v, settings: ExtractorSettings = ExtractorSettings()) -> Extraction:
+def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str = "exact") -> Extraction:
     """Run the extractor on one trace; raises FeatureError when it cannot.
 
     Args:
         t: times (us), increasing.
         v: free-surface velocity (m/s) at those times.
         settings: the analysis window, elastic cut-off and mixture size (`ExtractorSettings`).
+        method: "exact" fits the mixture to the standardized trace's exact CDF (`fit_mixture_exact`,
+            from starts made from the n_samples PIT samples); "pit" (the reference, 30-90 times slower)
+            fits it by scikit-learn's EM to the samples (`fit_mixture`). Both draw the samples: the
+            figures show them.
 
     Returns:
         An `Extraction`: the ten features (times us, velocities m/s) and the intermediate steps.
@@ -165,7 +173,12 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings()) -> Extracti
     rising = np.diff(y, prepend=-1.0) > 0
     n = settings.n_samples
     samples = np.interp((np.arange(n) + 0.5) / n, y[rising], tw[rising])
-    mixture = fit_mixture(samples, settings.n_components)
+    if method == "exact":
+        mixture = fit_mixture_exact(tw, y, samples, settings.n_components)
+    elif method == "pit":
+        mixture = fit_mixture(samples, settings.n_components)
+    else:
+        raise ValueError(f"unknown mixture fit {method!r}: 'exact' or 'pit'")
     cutoff = arrival + settings.cutoff_after_arrival_us
     early = split_early(mixture, cutoff)
     features = feature_values(t, v, tw, y, mixture, early, cutoff)
@@ -213,7 +226,8 @@ def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarr
 
 def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
     """The EM fit of highest likelihood over `MIXTURE_STARTS` fixed starts. EM runs on the standardized
-    samples, so the tolerance and scikit-learn's variance floor (reg_covar) do not depend on the time unit."""
+    samples, so the tolerance and scikit-learn's variance floor (reg_covar) do not depend on the time unit.
+    The reference path (`extract(..., method="pit")`); the extractor uses `fit_mixture_exact`."""
     from sklearn.mixture import GaussianMixture
 
     centre, spread = samples.mean(), samples.std()
@@ -228,6 +242,18 @@ def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
         if score > best_score:
             best, best_score = gm, score
     return Mixture(best.weights_, centre + spread * best.means_.ravel(), spread * np.sqrt(best.covariances_.ravel()))
+
+
+def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, samples: np.ndarray, n_components: int) -> Mixture:
+    """The EM fit of highest expected log-likelihood under the piecewise-linear CDF the PIT samples are
+    drawn from (`shockcal.mixture_fit`): the limit of `fit_mixture` as the number of samples grows. The
+    same starts (scikit-learn's, made from the samples), the same EM steps and stopping rule
+    (`MIXTURE_TOL`), the same variance floor, on the standardized scale."""
+    from shockcal.mixture_fit import fit_piecewise_linear_cdf
+
+    (weights, means, sds), _ = fit_piecewise_linear_cdf(t_window, cdf_window, n_components, MIXTURE_STARTS,
+                                                        MIXTURE_TOL, MIXTURE_MAX_ITER, starts=samples)
+    return Mixture(weights, means, sds)
 
 
 def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) -> dict:
