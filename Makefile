@@ -41,7 +41,7 @@ test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (r
 
 bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); installs the reference samplers
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,bench]'
-	@for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
+	$(PY) benchmarks/run_all.py
 
 validate: $(INSTALLED)  ## our hydrocode + extractor against the paper's FLAG features and measured features
 	$(PY) benchmarks/validate_flag.py

@@ -20,7 +20,7 @@ import pandas as pd
 from shockcal.errors import InputError
 from shockcal.hydro import JOHNSON_COOK_INPUTS, ShotParameters
 from shockcal.io import integer_ids, read_table, require_columns
-from shockcal.plausibility import range_problem
+from shockcal.plausibility import outside_box, range_problem
 
 log = logging.getLogger("shockcal.design")
 
@@ -134,8 +134,7 @@ def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], so
     for name in columns:
         low, high = box.bounds[name]
         values = design[name].to_numpy(dtype=float)
-        slack = 1e-9 * (high - low)  # float noise of a table written at a bound
-        outside = (values < low - slack) | (values > high + slack)
+        outside = outside_box(values, low, high)
         if not outside.any():
             continue
         first = int(np.argmax(outside))

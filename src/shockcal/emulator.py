@@ -31,6 +31,7 @@ from shockcal.features import CALIBRATION_FEATURES
 from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.io import atomic_path
 from shockcal.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
+from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
 
 # extra emulator inputs base^column: config emulator key of the base, design column
@@ -292,8 +293,7 @@ class Emulator:
                                  "emulator for this config")
         for name in [k for k in self._bounds if k in bounds]:
             (low, high), (lo, hi) = self._bounds[name], bounds[name]
-            slack = 1e-9 * (high - low)
-            if lo < low - slack or hi > high + slack:
+            if outside_box([lo, hi], low, high).any():
                 raise InputError(f"{label}: the prior box inputs.{name} = [{lo:g}, {hi:g}] is not inside the box the "
                                  f"emulator was fitted on [{low:g}, {high:g}]; refit the emulator on this box")
 
@@ -304,8 +304,7 @@ class Emulator:
             if name not in design:
                 continue
             values = design[name].to_numpy(dtype=float)
-            slack = 1e-9 * (high - low)
-            outside = (values < low - slack) | (values > high + slack)
+            outside = outside_box(values, low, high)
             if outside.any():
                 first = int(np.argmax(outside))
                 raise InputError(f"{source}: run {design['run'].iloc[first]}: {name} = {values[first]:g} is outside the "

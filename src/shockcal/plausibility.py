@@ -137,3 +137,14 @@ def release_times_us(flyer_mm: float, target_mm: float, rho0_g_cc: float, c1_Mba
     c_l = (c_bulk**2 + 4.0 * shear_modulus_Mbar / (3.0 * rho0_g_cc)) ** 0.5    # cm/us
     flyer, target = flyer_mm * 0.1, target_mm * 0.1                            # cm
     return target / c_l, flyer / c_bulk + (flyer + target) / c_l
+
+
+BOX_SLACK = 1e-9   # share of a box's width allowed outside it: the float noise of a value written at a bound
+
+
+def outside_box(values, low: float, high: float) -> np.ndarray:
+    """Mask of `values` outside [low, high] beyond the float noise of a value written at a bound and
+    read back (BOX_SLACK of the box's width)."""
+    slack = BOX_SLACK * (high - low)
+    values = np.asarray(values, dtype=float)
+    return (values < low - slack) | (values > high + slack)

@@ -15,6 +15,7 @@ import pandas as pd
 
 from shockcal.errors import InputError
 from shockcal.io import require_columns
+from shockcal.plausibility import outside_box
 
 log = logging.getLogger(__name__)
 
@@ -47,8 +48,7 @@ def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, see
             raise InputError(f"{source}: row {row}: {name} = {posterior[name].iloc[row]!r} is not a finite number")
         if bounds is not None and name in bounds:
             low, high = bounds[name]
-            slack = 1e-9 * (high - low)
-            outside = (values < low - slack) | (values > high + slack)
+            outside = outside_box(values, low, high)
             if outside.any():
                 row = int(np.argmax(outside))
                 raise InputError(f"{source}: row {row}: {name} = {values[row]:g} is outside the prior box inputs.{name} "

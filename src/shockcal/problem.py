@@ -24,6 +24,7 @@ from scipy import stats
 
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
+from shockcal.plausibility import outside_box
 
 LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
 
@@ -168,8 +169,7 @@ def prior_box(names, bounds: Mapping[str, tuple[float, float]], emulator_lower, 
         if name not in bounds:
             raise InputError(f"{label}: the prior box has no input {name}, which the emulator's calibration needs")
         lo, hi = (float(b) for b in bounds[name])
-        slack = 1e-9 * (high - low)       # float noise of a box written out and read back
-        if lo < low - slack or hi > high + slack:
+        if outside_box([lo, hi], low, high).any():
             unit = "" if units.get(name, "-") == "-" else f" {units[name]}"
             raise InputError(f"{label}: the prior box inputs.{name} = [{lo:g}, {hi:g}]{unit} is not inside the box the "
                              f"emulator was fitted on [{low:g}, {high:g}]{unit}; refit the emulator on this box, or give "
