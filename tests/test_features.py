@@ -388,3 +388,20 @@ def test_pit_reference_path_is_kept_and_unknown_fits_are_refused(settings):
         assert abs(exact.features[column] - pit.features[column]) * scale < 1.0, column
     with pytest.raises(ValueError, match="unknown mixture fit"):
         extract(T, trace(), settings, method="em")
+
+
+def test_slope_times_stay_inside_the_window_when_the_late_mixture_is_one_broad_component():
+    """A single-wave trace (large A) can leave EM one broad component of a few 1e-5 of the mass spread
+    over the plateau; its 0.9 quantile lies past the window, where the release has come: the slope times
+    are read at the window's end instead (the study's 104S runs 349 and 748 read v_slope2 = 0.001 m/s)."""
+    from shockcal.features import Mixture, feature_values
+
+    t = np.linspace(0.0, 2.4, 4801)
+    v = np.where(t < 0.88, 0.0, 213.0) * (t < 2.2)           # one wave, then the release at 2.2 us
+    t_window = t[(t >= 0.83) & (t <= 1.97)]
+    cdf = np.clip((t_window - 0.83) / 0.06, 0.0, 1.0)
+    mixture = Mixture(np.array([0.6, 0.39993, 7e-5]), np.array([0.882, 0.885, 1.76]), np.array([0.004, 0.003, 0.41]))
+    early = np.array([True, True, False])
+    features = feature_values(t, v, t_window, cdf, mixture, early, cutoff_us=0.92)
+    assert features["t_slope2"] <= t_window[-1] and features["t_slope1"] <= features["t_slope2"]
+    assert features["v_slope1"] == features["v_slope2"] == 213.0

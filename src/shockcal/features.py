@@ -208,14 +208,18 @@ def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarr
     its own: a few m/s ahead of the plastic wave at small A), the stand-in early component is broad,
     and its quantiles are kept inside the elastic part of the window: jump-off not before the window
     starts, elastic plateau not after the cut-off (unclamped, they fell 0.3 us before the arrival and
-    on the plastic plateau: v_elastic = v_plastic)."""
+    on the plastic plateau: v_elastic = v_plastic). The slope times are kept inside the analysis window:
+    a single-wave trace's late mixture can be one broad component (a few 1e-5 of the mass, spread over
+    the plateau) whose 0.9 quantile lies past the window's end, where the release has arrived (unclamped,
+    v_slope2 read 0.001 m/s on two of the study's 1000 104S runs)."""
     early_mix, late_mix = mixture.subset(early), mixture.subset(~early)
     jumpoff, elastic = early_mix.quantile(0.01), early_mix.quantile(0.99)
     if not ends_before(early_mix, cutoff_us).any():
         jumpoff, elastic = max(jumpoff, t_window[0]), min(elastic, cutoff_us)
-    slope1 = max(late_mix.quantile(0.1), elastic)     # a single wave's broad last component can reach back
-    times = {"jumpoff": jumpoff, "elastic": elastic,
-             "slope1": slope1, "slope2": max(late_mix.quantile(0.9), slope1),
+    end = t_window[-1]        # a single wave's late mixture can be one broad component of a few 1e-5 of the
+    slope1 = min(max(late_mix.quantile(0.1), elastic), end)     # mass spread over the plateau: it reaches back
+    times = {"jumpoff": jumpoff, "elastic": elastic,                # before the elastic time and past the window
+             "slope1": slope1, "slope2": min(max(late_mix.quantile(0.9), slope1), end),
              "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
     features = {}
     for name in FEATURES:
