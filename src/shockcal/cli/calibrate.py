@@ -55,7 +55,7 @@ def study_emulator(directory, config: dict):
     return emulator
 
 
-def summary_path(out, kind: str = "summary"):
+def companion_path(out, kind: str = "summary"):
     """The table of `kind` ("summary", "weighted") beside the posterior samples `out`."""
     from pathlib import Path
 
@@ -84,8 +84,8 @@ def run(args) -> int:
             "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
                        "log_likelihood (at the draw)"}
     write_table(posterior.draws, args.out, meta)
-    write_table(summary, summary_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
-    write_table(posterior.weighted_table(), summary_path(args.out, "weighted"),
+    write_table(summary, companion_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
+    write_table(posterior.weighted_table(), companion_path(args.out, "weighted"),
                 {**meta, "table": "posterior weighted draws",
                  "columns": "nautilus's weighted draws (the exact result): inputs in `units`; lambda_y (-); log_weight "
                             "(normalised, logsumexp = 0); log_likelihood"})

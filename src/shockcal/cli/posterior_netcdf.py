@@ -28,7 +28,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from shockcal import __version__
-    from shockcal.cli.calibrate import summary_path
+    from shockcal.cli.calibrate import companion_path
     from shockcal.errors import InputError
     from shockcal.inference_data import (
         config_digest,
@@ -49,7 +49,7 @@ def run(args) -> int:
     if any(key not in meta for key in needed):
         raise InputError(f"{args.posterior}: not a posterior written by `shockcal calibrate` "
                          f"(metadata {[k for k in needed if k not in meta]} missing)")
-    weighted_path = summary_path(args.posterior, "weighted")
+    weighted_path = companion_path(args.posterior, "weighted")
     weighted = read_table(weighted_path) if Path(weighted_path).is_file() else None
     names = [c for c in draws.columns if c != "log_likelihood"]
     observed, observed_sd = observed_frames(meta["shots"], meta["observed"], meta["observed_sd_m_s"])

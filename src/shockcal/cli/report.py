@@ -54,7 +54,7 @@ def run(args) -> int:
 
     import pandas as pd
 
-    from shockcal.cli.calibrate import summary_path
+    from shockcal.cli.calibrate import companion_path
     from shockcal.coverage import coverage_table
     from shockcal.io import read_table, read_table_metadata
 
@@ -65,7 +65,7 @@ def run(args) -> int:
     if posteriors:
         summaries, evidence = [], []
         for name, path in posteriors.items():
-            summaries.append(read_table(summary_path(path)).assign(calibration=name))
+            summaries.append(read_table(companion_path(path)).assign(calibration=name))
             meta = read_table_metadata(path)
             evidence.append({"calibration": name, "shots": "+".join(meta.get("shots", [])),
                              "log_evidence": meta.get("log_evidence"), "log_evidence_sd": meta.get("log_evidence_sd"),
