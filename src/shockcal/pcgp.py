@@ -290,20 +290,18 @@ class PCGPEmulator:
         return factors if self.variance is None else factors * self.variance.sd_factors(x, raw_sd)
 
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Mean and variance (N, p) of each basis weight at scaled inputs x, on `settings.n_jobs`
-        threads: the components' cross-covariances on Python threads (numba's kernel releases the
-        GIL), then their triangular solves on BLAS threads (scipy's LAPACK wrappers hold the GIL).
+        """Mean and variance (N, p) of each basis weight at scaled inputs x: each component's
+        cross-covariance and triangular solve on one of `settings.n_jobs` Python threads, BLAS on
+        one thread (numba's kernel releases the GIL). A 1000-run solve of 100 points took 2.2 times
+        the CPU on two BLAS threads as on one, for no shorter wall time (docs/emulator.md, "Speed").
         In batches of PREDICT_BATCH points, which bounds the memory of the cross-covariances."""
-        threads = self.settings.n_jobs
         means, variances = [], []
-        for start in range(0, len(x), PREDICT_BATCH):
-            batch = x[start:start + PREDICT_BATCH]
-            with ThreadPoolExecutor(threads) as pool:
-                cross = list(pool.map(lambda gp: gp.prior_cov(batch, gp.x), self.gps))  # noqa: B023 (used at once)
-            with _blas_threads().limit(limits=threads, user_api="blas"):
-                parts = [gp.predict_from_cross_cov(k) for gp, k in zip(self.gps, cross)]
-            means.append(np.column_stack([m for m, _ in parts]))
-            variances.append(np.column_stack([v for _, v in parts]))
+        with ThreadPoolExecutor(self.settings.n_jobs) as pool, _blas_threads().limit(limits=1, user_api="blas"):
+            for start in range(0, len(x), PREDICT_BATCH):
+                batch = x[start:start + PREDICT_BATCH]
+                parts = list(pool.map(lambda gp: gp.predict(batch), self.gps))  # noqa: B023 (used at once)
+                means.append(np.column_stack([m for m, _ in parts]))
+                variances.append(np.column_stack([v for _, v in parts]))
         return np.concatenate(means), np.concatenate(variances)
 
     def loo(self) -> HeldOut:
