@@ -172,7 +172,7 @@ def main(argv=None) -> int:
     if args.four_shot_emulator and args.four_shot_observed:
         four = Emulator.load(args.four_shot_emulator)
         four_config = load_config(args.four_shot_config or args.config)
-        shots = list(four.shot_inputs)
+        shots = list(four.shots)
         run = timed_calibration(four, shots, read_table(args.four_shot_observed), four_config, "four-shot joint now")
         per_eval = run["inside"] / run["evaluations"]
         print(f"  four-shot joint: now {run['wall']:.0f} s; {1e6 * per_eval:.0f} us an evaluation in the run")
