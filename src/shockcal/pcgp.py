@@ -292,8 +292,9 @@ class PCGPEmulator:
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Mean and variance (N, p) of each basis weight at scaled inputs x: each component's
         cross-covariance and triangular solve on one of `settings.n_jobs` Python threads, BLAS on
-        one thread (numba's kernel releases the GIL). A 1000-run solve of 100 points took 2.2 times
-        the CPU on two BLAS threads as on one, for no shorter wall time (docs/emulator.md, "Speed").
+        one thread. numba's kernel releases the GIL and scipy's solve holds it, so the solves run one
+        at a time while other components' cross-covariances are computed. A 1000-run solve of 100
+        points took 2.2 times the CPU on two BLAS threads as on one (docs/emulator.md, "Speed").
         In batches of PREDICT_BATCH points, which bounds the memory of the cross-covariances."""
         means, variances = [], []
         with ThreadPoolExecutor(self.settings.n_jobs) as pool, _blas_threads().limit(limits=1, user_api="blas"):
