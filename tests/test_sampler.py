@@ -87,3 +87,24 @@ def test_systematic_resampling_keeps_each_point_floor_or_ceil_of_its_share():
     counts = np.bincount(draws.resample(1000, np.random.default_rng(0)), minlength=4)
     assert counts.sum() == 1000 and np.all(np.abs(counts - 1000 * w) < 1)
     assert draws.kish_ess() == pytest.approx(1 / np.sum(w**2))
+
+
+def test_evidence_sd_matches_the_spread_over_seeds_and_the_truth():
+    # A 3-D Gaussian likelihood in a box, log Z known exactly: over 8 seeds the runs' log Z scatter
+    # about the truth by the sd each run reports (`evidence_sd`, from nautilus's counts): the mean z^2
+    # lies in its chi-square(8)/8 band (0.21-2.51, 98%), and so does the seeds' variance over the mean
+    # reported variance (measured 2026-11-26: 0.032 reported, 0.020 over the seeds, mean z^2 0.57). On the study's 104S
+    # posterior the same estimate was checked against 12 seeds (docs/posteriors.md).
+    sd, lower, upper = np.array([0.3, 0.5, 0.2]), np.full(3, -3.0), np.full(3, 3.0)
+
+    def log_likelihood(theta):
+        return -0.5 * np.sum((theta / sd) ** 2, axis=1)
+
+    truth = 0.5 * np.sum(np.log(2 * np.pi * sd**2)) - np.log(np.prod(upper - lower))
+    runs = [nested_sample(_box_transform(lower, upper), log_likelihood, 3, n_live=200, n_eff=400, seed=seed)
+            for seed in range(8)]
+    log_z = np.array([r.log_evidence for r in runs])
+    reported = np.array([r.log_evidence_sd for r in runs])
+    mean_z2 = np.mean(((log_z - truth) / reported) ** 2)
+    assert 0.21 < mean_z2 < 2.51, (mean_z2, log_z - truth, reported)
+    assert 0.21 < np.var(log_z, ddof=1) / np.mean(reported**2) < 2.51
