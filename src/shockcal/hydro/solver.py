@@ -151,7 +151,8 @@ class Cells(NamedTuple):
     evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
     is one valid up to `FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
     so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
-    a pow or log; inside the floor times the rate factor (one log), elastic without a pow."""
+    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. `hard` and
+    the floors are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
