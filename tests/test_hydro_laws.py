@@ -167,3 +167,24 @@ def test_law_parameters_checked_on_creation():
         LawShotParameters("sg", STEINBERG_6061, V_104S, 27.0)
     with pytest.raises(InputError, match="shear_modulus_GPa must be a positive number"):
         LawShotParameters("za", ZA_AL, V_104S)
+
+
+@pytest.mark.slow                                   # a fresh cache compiles every kernel: 46 s at load 13
+def test_law_kernels_load_from_numba_cache_in_a_second_process(tmp_path):
+    """The general kernels stay cacheable (`cache=True` through the type-dispatched overloads): a second
+    process finds SG's specialisation of `simulate` in a fresh cache and compiles nothing."""
+    import os
+    import subprocess
+    import sys
+
+    script = ("from shockcal.hydro import Geometry, LawShotParameters, run_shot\n"
+              "from shockcal.hydro.solver import simulate\n"
+              f"params = LawShotParameters('sg', {STEINBERG_6061!r}, 204.0)\n"
+              "assert run_shot(params, Geometry(0.05, 0.05, 0.01)).status == 'ok'\n"
+              "print(len(simulate.stats.cache_hits), len(simulate.stats.cache_misses))\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    first, second = (subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)
+                     for _ in range(2))
+    assert first.returncode == 0 and second.returncode == 0, first.stderr + second.stderr
+    assert first.stdout.split() == ["0", "1"]          # compiled and saved
+    assert second.stdout.split() == ["1", "0"]         # loaded
