@@ -305,41 +305,42 @@ def inside_floor(equivalent_stress, flow_floor, strain_rate, strength):
                                                          strength.rate_ref)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def johnson_cook_floored_return(cells, j, s_trial, T_cell, strain_rate, strength, material):
-    """(s, d eps_p) of cell j under Johnson-Cook (`Strength`): elastic without evaluating the flow stress
-    while the trial lies inside the cell's floor, else the return at the cell's temperature (K) and
-    current strain rate (1/us), which updates the cell's plastic strain, hardening and floors."""
-    floor = floor_at(T_cell, cells.flow_floor[j], cells.floor_hotter[j], cells.floor_T[j])
+def johnson_cook_floored_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter,
+                                floor_T, strength, material):
+    """Johnson-Cook (`Strength`): elastic without evaluating the flow stress while the trial lies inside
+    the cell's floor, else the return at the cell's temperature (K) and current strain rate (1/us), with
+    the cell's new plastic strain, hardening and floors."""
+    floor = floor_at(T_cell, flow_floor, floor_hotter, floor_T)
     if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
-        return s_trial, 0.0
-    s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, cells.hard[j],
-                                                                strength, material)
+        return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material)
     if d_eps > 0.0:
-        cells.eps_p[j] += d_eps
-        cells.hard[j] = hardening(strength.A, strength.B, strength.n, cells.eps_p[j])
-    cells.floor_T[j] = T_cell
-    cells.flow_floor[j], cells.floor_hotter[j] = new_floors(cells.hard[j], thermal, thermal_hotter)
-    return s_new, d_eps
+        eps_p += d_eps
+        hard = hardening(strength.A, strength.B, strength.n, eps_p)
+    flow_floor, floor_hotter = new_floors(hard, thermal, thermal_hotter)
+    return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, T_cell
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def law_return(cells, j, s_trial, T_cell, strain_rate, P, eta, G, law):
-    """(s, d eps_p) of cell j under any law (`LawStrength.law`): the trial returned onto the law's flow
-    stress at the cell's plastic strain, equivalent strain rate (1/us), temperature (K), pressure (Mbar)
-    and density ratio, evaluated every step (no floor), with the cell's shear modulus G (Mbar). A cell
+def law_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+               material):
+    """Any law (`LawStrength`): the trial returned onto the law's flow stress at the cell's plastic strain,
+    equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, evaluated every
+    step (no floor; `hard` and the floors pass through), with the cell's shear modulus G (Mbar). A cell
     with G = 0 (molten) carries no deviator and gains no plastic strain."""
     if G <= 0.0:
-        return 0.0, 0.0
-    Y = law_flow_stress(law, cells.eps_p[j], equivalent_strain_rate(strain_rate), T_cell, P, eta)
+        return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    Y = law_flow_stress(strength.law, eps_p, equivalent_strain_rate(strain_rate), T_cell, P, eta)
     s_new, d_eps = radial_return(s_trial, Y, G)
-    cells.eps_p[j] += d_eps
-    return s_new, d_eps
+    return s_new, d_eps, eps_p + d_eps, hard, flow_floor, floor_hotter, floor_T
 
 
-def plastic_return(cells, j, s_trial, T_cell, strain_rate, P, eta, G, strength, material):
-    """(s, d eps_p) of cell j after its elastic trial deviator s_trial (Mbar): `johnson_cook_floored_return`
-    for `Strength`, `law_return` for `LawStrength` (chosen when numba compiles, by the type of `strength`)."""
+def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+                   material):
+    """A cell's return after its elastic trial deviator s_trial (Mbar), on scalars: (s, d eps_p, and the
+    cell's new eps_p, hard, flow_floor, floor_hotter, floor_T). `johnson_cook_floored_return` for
+    `Strength`, `law_return` for `LawStrength`, chosen when numba compiles by the type of `strength`
+    and inlined. Scalars in and out: inlined code that indexes the cell arrays cost the 104S run 23%
+    more CPU (reference counts per cell)."""
 
 
 def cell_shear_modulus(strength, P, T, eta):
@@ -356,12 +357,9 @@ def _is_johnson_cook(strength):
 
 
 @overload(plastic_return, inline="always")
-def _plastic_return(cells, j, s_trial, T_cell, strain_rate, P, eta, G, strength, material):
-    if _is_johnson_cook(strength):
-        return lambda cells, j, s_trial, T_cell, strain_rate, P, eta, G, strength, material: (
-            johnson_cook_floored_return(cells, j, s_trial, T_cell, strain_rate, strength, material))
-    return lambda cells, j, s_trial, T_cell, strain_rate, P, eta, G, strength, material: (
-        law_return(cells, j, s_trial, T_cell, strain_rate, P, eta, G, strength.law))
+def _plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+                    material):
+    return johnson_cook_floored_return if _is_johnson_cook(strength) else law_return
 
 
 @overload(cell_shear_modulus, inline="always")
@@ -394,7 +392,8 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
     diagnostic only), temperature (K) and plastic strain."""
     u = nodes.u
     mass, length, E, P, s, sigma = cells.mass, cells.length, cells.E, cells.P, cells.s, cells.sigma
-    eps_p = cells.eps_p
+    eps_p, hard, flow_floor, floor_hotter, floor_T = (cells.eps_p, cells.hard, cells.flow_floor, cells.floor_hotter,
+                                                      cells.floor_T)
     N = E.shape[0] - 1
     g_rho0 = material.gamma0 * material.rho0
     max_signal_rate = numerics.cfl / numerics.dt_max
@@ -417,7 +416,9 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
-        s_new, d_eps = plastic_return(cells, j, s_trial, T_cell, strain_rate, P[j], eta, G, strength, material)
+        s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j] = plastic_return(
+            s_trial, T_cell, strain_rate, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
+            strength, material)
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)
