@@ -18,9 +18,10 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
-from shockcal.hydro import JOHNSON_COOK_INPUTS, ShotParameters
+from shockcal.hydro import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters
 from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
+from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.design")
 
@@ -149,30 +150,40 @@ def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], so
 
 @dataclass(frozen=True)
 class ShotMapping:
-    """How one shot reads a design row (SPEC section 3): the input that is its impact velocity, and
-    the inputs whose sum is its shear modulus (the Johnson-Cook inputs are every shot's)."""
+    """How one shot reads a design row (SPEC section 3): the input that is its impact velocity (cm/us),
+    the inputs whose sum is its shear modulus (Mbar; none for a law with its own G law), and the strength
+    law's inputs every shot shares: Johnson-Cook's A, B, C, n, m in Table IV units, or another law's
+    declared parameters in the units their names carry (`shockcal.hydro.laws`)."""
 
     shot: str
     velocity_input: str
     shear_modulus_inputs: tuple[str, ...]
+    model: str = "johnson-cook"
+    strength_inputs: tuple[str, ...] = JOHNSON_COOK_INPUTS
 
     def inputs(self) -> list[str]:
-        """The design columns the shot depends on: A, B, C, n, m, its velocity, its shear-modulus terms."""
-        return [*JOHNSON_COOK_INPUTS, self.velocity_input, *self.shear_modulus_inputs]
+        """The design columns the shot depends on: the law's inputs, its velocity, its shear-modulus terms."""
+        return [*self.strength_inputs, self.velocity_input, *self.shear_modulus_inputs]
 
-    def parameters(self, row) -> ShotParameters:
-        """One design row (a mapping of input name to value, Table IV units) as this shot's hydrocode
-        inputs; the values reach the kernel unconverted (`ShotParameters.from_table_iv`)."""
-        return ShotParameters.from_table_iv(*(float(row[k]) for k in JOHNSON_COOK_INPUTS),
-                                            velocity_cm_us=float(row[self.velocity_input]),
-                                            shear_modulus_Mbar=float(sum(row[k] for k in self.shear_modulus_inputs)))
+    def parameters(self, row) -> ShotParameters | LawShotParameters:
+        """One design row (a mapping of input name to value) as this shot's hydrocode inputs. Johnson-Cook's
+        Table IV values reach the kernel unconverted (`ShotParameters.from_table_iv`); another law's go
+        through `LawShotParameters` (InputError for a row that breaks the law's constraints)."""
+        velocity = float(row[self.velocity_input])
+        shear = float(sum(row[k] for k in self.shear_modulus_inputs)) if self.shear_modulus_inputs else None
+        if self.model == "johnson-cook":
+            return ShotParameters.from_table_iv(*(float(row[k]) for k in JOHNSON_COOK_INPUTS),
+                                                velocity_cm_us=velocity, shear_modulus_Mbar=shear)
+        return LawShotParameters(self.model, {k: float(row[k]) for k in self.strength_inputs},
+                                 velocity * CM_US_TO_M_S, None if shear is None else shear * MBAR_TO_GPA)
 
     def check_positive(self, design: pd.DataFrame, source: str | Path) -> None:
         """Reject rows whose velocity or shear modulus is not positive for this shot, before any run starts."""
-        velocity = design[self.velocity_input].to_numpy(dtype=float)
-        shear = design[list(self.shear_modulus_inputs)].to_numpy(dtype=float).sum(axis=1)
-        for label, values in ((f"impact velocity {self.velocity_input}", velocity),
-                              (f"shear modulus {'+'.join(self.shear_modulus_inputs)}", shear)):
+        checks = [(f"impact velocity {self.velocity_input}", design[self.velocity_input].to_numpy(dtype=float))]
+        if self.shear_modulus_inputs:
+            checks.append((f"shear modulus {'+'.join(self.shear_modulus_inputs)}",
+                           design[list(self.shear_modulus_inputs)].to_numpy(dtype=float).sum(axis=1)))
+        for label, values in checks:
             bad = values <= 0
             if bad.any():
                 row = design.loc[bad, "run"].iloc[0]

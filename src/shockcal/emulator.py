@@ -28,7 +28,6 @@ from shockcal.design import ShotMapping
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.features import CALIBRATION_FEATURES
-from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.io import atomic_path
 from shockcal.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
 from shockcal.plausibility import outside_box
@@ -76,10 +75,14 @@ class InputMap:
 
 
 def shot_input_map(shot: ShotMapping, bounds: Mapping[str, tuple[float, float]], powers=()) -> InputMap:
-    """A per-shot emulator's inputs: A, B, C, n, m, the shot's velocity, its summed shear modulus,
-    then the `powers` (base, design column); `bounds`: the prior box by design input."""
-    terms = [[k] for k in JOHNSON_COOK_INPUTS] + [[shot.velocity_input], list(shot.shear_modulus_inputs)]
-    names = [*JOHNSON_COOK_INPUTS, shot.velocity_input, f"G_{shot.shot}"]
+    """A per-shot emulator's inputs: the law's (A, B, C, n, m for Johnson-Cook), the shot's velocity, its
+    summed shear modulus (when the law has no G law), then the `powers` (base, design column); `bounds`:
+    the prior box by design input."""
+    terms = [[k] for k in shot.strength_inputs] + [[shot.velocity_input]]
+    names = [*shot.strength_inputs, shot.velocity_input]
+    if shot.shear_modulus_inputs:
+        terms.append(list(shot.shear_modulus_inputs))
+        names.append(f"G_{shot.shot}")
     return _box_map(bounds, names, terms, powers)
 
 

@@ -2,7 +2,8 @@
 
 A run that fails numerically, or raises, is recorded with status "failed" and a reason; the batch
 always continues. Columns of the simulations table (see docs/hydro.md):
-run, shot, the shot's design inputs (Table IV units), impact_velocity_m_s, shear_modulus_GPa,
+run, shot, the shot's design inputs (Table IV units; another law's in its names' units), impact_velocity_m_s,
+shear_modulus_GPa (NaN for a law with its own G law),
 status, reason, max_strain_rate_per_us, max_temperature_K, max_plastic_strain, energy_error,
 n_steps, wall_time_s, t_us (list, microseconds), v_m_s (list, free-surface velocity in m/s).
 """
@@ -15,9 +16,9 @@ import numpy as np
 import pandas as pd
 
 from shockcal.design import ShotMapping
+from shockcal.errors import InputError
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
 from shockcal.progress import progress
-from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.simulate")
 DIAGNOSTICS = ["max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
@@ -44,12 +45,18 @@ def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geomet
     shot, inputs = mapping.shot, mapping.inputs()
     rows = []
     for record in progress(design.to_dict("records"), len(design), f"shot {shot}", "run", log):
-        params = mapping.parameters(record)
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
-               "impact_velocity_m_s": params.table_iv().velocity_cm_us * CM_US_TO_M_S,
-               "shear_modulus_GPa": params.table_iv().shear_modulus_Mbar * MBAR_TO_GPA}
+               "impact_velocity_m_s": np.nan, "shear_modulus_GPa": np.nan}
         try:
+            params = mapping.parameters(record)        # InputError: a row that breaks the law's constraints
+            row["impact_velocity_m_s"] = params.velocity_m_s
+            row["shear_modulus_GPa"] = np.nan if params.shear_modulus_GPa is None else params.shear_modulus_GPa
             result = run_shot(params, geometry, material, settings)
+        except InputError as exc:
+            log.warning("run %s of shot %s: %s", row["run"], shot, exc)
+            rows.append({**row, "status": "failed", "reason": f"InputError: {exc}",
+                         **{k: np.nan for k in DIAGNOSTICS}, "t_us": [], "v_m_s": []})
+            continue
         except Exception as exc:  # a run must never kill the batch; the reason is kept
             log.exception("run %s of shot %s raised", row["run"], shot)
             rows.append({**row, "status": "failed", "reason": f"{type(exc).__name__}: {exc}",

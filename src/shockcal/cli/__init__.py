@@ -31,6 +31,7 @@ STAGE_MODULES = [
     "shockcal.cli.stage_times",
     "shockcal.cli.config_doc",
     "shockcal.cli.flow_stress",
+    "shockcal.cli.compare_models",
 ]
 
 

@@ -6,9 +6,9 @@ returns the target's free-surface velocity history with diagnostics; the inputs 
 is the ground floor: it imports nothing of the study (config, design, features). See docs/hydro.md.
 """
 
-from shockcal.hydro.parameters import JOHNSON_COOK_INPUTS, ShotParameters, TableIV
+from shockcal.hydro.parameters import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters, TableIV
 from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.shot import RunResult, run_shot
 
-__all__ = ["AL5083", "JOHNSON_COOK_INPUTS", "Geometry", "HydroSettings", "MaterialProperties", "RunResult",
-           "ShotParameters", "TableIV", "run_shot"]
+__all__ = ["AL5083", "JOHNSON_COOK_INPUTS", "Geometry", "HydroSettings", "LawShotParameters", "MaterialProperties",
+           "RunResult", "ShotParameters", "TableIV", "run_shot"]

@@ -1,4 +1,4 @@
-"""The inputs of one hydrocode run of one shot: Johnson-Cook strength, impact velocity, shear modulus.
+"""The inputs of one hydrocode run of one shot: strength law, impact velocity, shear modulus.
 
 A physicist writes them in the units of the trade, the unit in each name:
 
@@ -8,13 +8,27 @@ The design tables keep the paper's Table IV units (Mbar, cm/us), which are the k
 `ShotParameters.from_table_iv` takes a design row's values and hands them to the kernel unconverted
 (a round trip through MPa would change the last bit of about one value in eight). `table_iv()` is
 the kernel's door: the only place user units become code units.
+
+Any strength law of `shockcal.hydro.laws` (docs/strength_laws.md), by its declared parameter names:
+
+    LawShotParameters("steinberg-guinan", {"Y0_GPa": 0.29, "Ymax_GPa": 0.68, "beta": 125, "n": 0.1,
+                      "G0_GPa": 27.6, "dGdP": 1.8, "dGdT_over_G0_per_K": -6.16e-4}, velocity_m_s=204)
+
+Laws with a shear-modulus law (Steinberg-Guinan, PTW) take G from it, cell by cell; the others
+(Johnson-Cook, Zerilli-Armstrong) need `shear_modulus_GPa`. Johnson-Cook given this way runs the
+solver's general return (every step, no floors), which gives the same traces bit for bit as
+`ShotParameters`' floored one, only slower (tests/test_hydro_laws.py).
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
+from shockcal.errors import InputError
+from shockcal.hydro.laws import code_parameters, get_law
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA, MBAR_TO_MPA
 
 # The Johnson-Cook inputs every shot shares (SPEC section 3), as the design tables name them.
@@ -71,3 +85,44 @@ class ShotParameters:
             return self._table_iv
         return TableIV(self.A_MPa / MBAR_TO_MPA, self.B_MPa / MBAR_TO_MPA, float(self.C), float(self.n), float(self.m),
                        self.velocity_m_s / CM_US_TO_M_S, self.shear_modulus_GPa / MBAR_TO_GPA)
+
+
+@dataclass(frozen=True)
+class LawShotParameters:
+    """The inputs of one run of one shot under any strength law, in user units; checked on creation
+    (InputError naming the model or parameter).
+
+    Args:
+        model: the law (`shockcal.hydro.laws.get_law`: johnson-cook, steinberg-guinan, ptw,
+            zerilli-armstrong, or an alias jc, sg, za).
+        values: the law's parameters by their declared names, in the units the names carry (Y0_GPa,
+            C0_MPa, ...); declared defaults fill the material constants left out.
+        velocity_m_s: impact velocity of the flyer (m/s).
+        shear_modulus_GPa: G of flyer and target (GPa) for laws without a shear-modulus law
+            (Johnson-Cook, Zerilli-Armstrong); None for Steinberg-Guinan and PTW, whose G(P, T) is theirs.
+    """
+
+    model: str
+    values: Mapping[str, float]
+    velocity_m_s: float
+    shear_modulus_GPa: float | None = None
+
+    def __post_init__(self):
+        law = get_law(self.model)
+        code_parameters(law, self.values)
+        if law.shear_modulus is not None and self.shear_modulus_GPa is not None:
+            raise InputError(f"{law.name}: shear_modulus_GPa given, but the law computes G(P, T) itself "
+                             f"(G0_GPa is its parameter)")
+        if law.shear_modulus is None and not (self.shear_modulus_GPa is not None
+                                              and math.isfinite(self.shear_modulus_GPa)
+                                              and self.shear_modulus_GPa > 0):
+            raise InputError(f"{law.name}: shear_modulus_GPa must be a positive number (the law has no G law); "
+                             f"got {self.shear_modulus_GPa}")
+
+    def law_parameters(self):
+        """The law's named tuple in code units (Mbar, K, 1/us, g/cc)."""
+        return code_parameters(get_law(self.model), self.values)
+
+    def shear_modulus_Mbar(self) -> float:
+        """The constant G in Mbar, NaN (unused) for laws with their own shear-modulus law."""
+        return math.nan if self.shear_modulus_GPa is None else self.shear_modulus_GPa / MBAR_TO_GPA

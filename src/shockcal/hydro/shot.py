@@ -4,7 +4,8 @@
     params = ShotParameters(A_MPa=335, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
     result = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=3.0))
 
-`result.t_us` and `result.v_m_s` are the target's free-surface velocity history (us, m/s).
+`result.t_us` and `result.v_m_s` are the target's free-surface velocity history (us, m/s). Any
+strength law: `run_shot(LawShotParameters("sg", {...}, velocity_m_s=204), geometry)`.
 """
 
 from __future__ import annotations
@@ -15,9 +16,9 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from shockcal.hydro.parameters import ShotParameters
+from shockcal.hydro.parameters import LawShotParameters, ShotParameters
 from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
-from shockcal.hydro.solver import FAILURE_REASONS, STATUS_OK, Strength, simulate
+from shockcal.hydro.solver import FAILURE_REASONS, STATUS_OK, LawStrength, Strength, simulate
 from shockcal.units import CM_US_TO_M_S, UM_TO_CM
 
 
@@ -48,12 +49,13 @@ class RunResult:
 STUDY_NUMERICS = HydroSettings()
 
 
-def run_shot(params: ShotParameters, geometry: Geometry, material: MaterialProperties = AL5083,
+def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties = AL5083,
              settings: HydroSettings = STUDY_NUMERICS) -> RunResult:
     """Simulate one symmetric shot to `geometry.end_us`.
 
     Args:
-        params: Johnson-Cook parameters, impact velocity and shear modulus (`ShotParameters`, user units).
+        params: Johnson-Cook parameters, impact velocity and shear modulus (`ShotParameters`, user units),
+            or any strength law's (`LawShotParameters`).
         geometry: flyer and target thickness (mm), the simulated time (us) and the plates' initial
             temperature (K; hot plates start expanded at zero pressure, `MaterialProperties.initial_state`).
         material: EOS and thermal constants of flyer and target (default Al-5083, the paper's Table II).
@@ -67,12 +69,10 @@ def run_shot(params: ShotParameters, geometry: Geometry, material: MaterialPrope
     nf, nt = settings.cells(geometry.flyer_mm), settings.cells(geometry.target_mm)
     dt_out = settings.output_dt_us()
     t_out = np.arange(int(round(geometry.end_us / dt_out)) + 1) * dt_out
-    inputs = params.table_iv()
+    velocity, strength = kernel_strength(params, material)
     initial = material.initial_state(geometry.initial_temperature_K)
     dx = settings.cell_size_um * UM_TO_CM
-    kernel_args = dict(nf=nf, nt=nt, dx=dx, velocity=inputs.velocity_cm_us, initial=initial,
-                       strength=Strength(inputs.shear_modulus_Mbar, inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n,
-                                         inputs.m, material.rate_ref_per_us()),
+    kernel_args = dict(nf=nf, nt=nt, dx=dx, velocity=velocity, initial=initial, strength=strength,
                        material=material.code_units(), numerics=settings.numerics(), t_out=t_out)
     load_kernel(simulate, tuple(kernel_args.values()))
     start = time.perf_counter()
@@ -90,6 +90,16 @@ def run_shot(params: ShotParameters, geometry: Geometry, material: MaterialPrope
     return RunResult(t_out, out.v_free_surface * CM_US_TO_M_S, "ok" if out.status == STATUS_OK else "failed", reason,
                      out.max_plastic_rate, out.max_temperature, out.max_plastic_strain, energy_error,
                      int(out.n_steps), wall, energy)
+
+
+def kernel_strength(params: ShotParameters | LawShotParameters, material: MaterialProperties):
+    """(impact velocity in cm/us, the kernel's strength tuple): `Strength` (Johnson-Cook with the
+    material's T_ref, T_melt and reference rate, floored return) or `LawStrength` (any law)."""
+    if isinstance(params, LawShotParameters):
+        return params.velocity_m_s / CM_US_TO_M_S, LawStrength(params.law_parameters(), params.shear_modulus_Mbar())
+    inputs = params.table_iv()
+    return inputs.velocity_cm_us, Strength(inputs.shear_modulus_Mbar, inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n,
+                                           inputs.m, material.rate_ref_per_us())
 
 
 def load_kernel(kernel, args) -> None:

@@ -23,12 +23,14 @@ rear node nf and the target's front node nf+1. Both outer nodes are free surface
    velocity and the energy an impact dissipates goes to the interface cells; under tension the
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
-   only), elastic trial deviator and Johnson-Cook radial return (skipped while the trial lies inside
-   the cell's flow-stress floor: `floor_at`, `new_floors`), energy equation, EOS;
+   only), the cell's shear modulus, elastic trial deviator and radial return onto the strength law
+   (`plastic_return`: Johnson-Cook's skipped while the trial lies inside the cell's flow-stress floor,
+   `floor_at`, `new_floors`; any other law's evaluated every step), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
-(`Material`, `Strength`, `Numerics`; `shockcal.units` converts). Kernels that loop over the mesh
+(`Material`, `Strength` for Johnson-Cook or `LawStrength` for any law, `Numerics`; `shockcal.units`
+converts); numba compiles the kernels once per strength tuple type. Kernels that loop over the mesh
 take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
 so its nodes keep their initial velocities bit for bit, and the active window grows by one node
@@ -44,8 +46,10 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
+from shockcal.hydro.laws.kernels import law_flow_stress, law_shear_modulus
 from shockcal.hydro.strength import (
     equivalent_strain_rate,
     flow_stress,
@@ -99,6 +103,15 @@ class Strength(NamedTuple):
     rate_ref: float
 
 
+class LawStrength(NamedTuple):
+    """Any strength law of `shockcal.hydro.laws` in one run: its named tuple in code units and the
+    shot's shear modulus G (Mbar), used only by laws without a shear-modulus law of their own
+    (Johnson-Cook, Zerilli-Armstrong). numba compiles the kernels once per law tuple type."""
+
+    law: tuple
+    G: float
+
+
 class Numerics(NamedTuple):
     """Artificial viscosity and time stepping (us)."""
 
@@ -138,7 +151,8 @@ class Cells(NamedTuple):
     evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
     is one valid up to `FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
     so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
-    a pow or log; inside the floor times the rate factor (one log), elastic without a pow."""
+    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. `hard` and
+    the floors are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
@@ -165,7 +179,7 @@ def initial_mesh(nf, nt, dx, velocity, initial, strength, material):
     length[gap] = 0.0
     E = np.full(N + 1, initial.E)
     E[gap] = 0.0
-    hard = np.full(N + 1, hardening(strength.A, strength.B, strength.n, 0.0))
+    hard = np.full(N + 1, initial_hardening(strength))
     cells = Cells(mass, length, E, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
                   np.zeros(N + 1), hard, np.zeros(N + 1), np.zeros(N + 1), np.full(N + 1, np.inf))
     u = np.zeros(N + 2)
@@ -291,6 +305,77 @@ def inside_floor(equivalent_stress, flow_floor, strain_rate, strength):
                                                          strength.rate_ref)
 
 
+def johnson_cook_floored_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter,
+                                floor_T, strength, material):
+    """Johnson-Cook (`Strength`): elastic without evaluating the flow stress while the trial lies inside
+    the cell's floor, else the return at the cell's temperature (K) and current strain rate (1/us), with
+    the cell's new plastic strain, hardening and floors."""
+    floor = floor_at(T_cell, flow_floor, floor_hotter, floor_T)
+    if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
+        return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material)
+    if d_eps > 0.0:
+        eps_p += d_eps
+        hard = hardening(strength.A, strength.B, strength.n, eps_p)
+    flow_floor, floor_hotter = new_floors(hard, thermal, thermal_hotter)
+    return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, T_cell
+
+
+def law_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+               material):
+    """Any law (`LawStrength`): the trial returned onto the law's flow stress at the cell's plastic strain,
+    equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, evaluated every
+    step (no floor; `hard` and the floors pass through), with the cell's shear modulus G (Mbar). A cell
+    with G = 0 (molten) carries no deviator and gains no plastic strain."""
+    if G <= 0.0:
+        return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    Y = law_flow_stress(strength.law, eps_p, equivalent_strain_rate(strain_rate), T_cell, P, eta)
+    s_new, d_eps = radial_return(s_trial, Y, G)
+    return s_new, d_eps, eps_p + d_eps, hard, flow_floor, floor_hotter, floor_T
+
+
+def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+                   material):
+    """A cell's return after its elastic trial deviator s_trial (Mbar), on scalars: (s, d eps_p, and the
+    cell's new eps_p, hard, flow_floor, floor_hotter, floor_T). `johnson_cook_floored_return` for
+    `Strength`, `law_return` for `LawStrength`, chosen when numba compiles by the type of `strength`
+    and inlined. Scalars in and out: inlined code that indexes the cell arrays cost the 104S run 23%
+    more CPU (reference counts per cell)."""
+
+
+def cell_shear_modulus(strength, P, T, eta):
+    """The shear modulus (Mbar) of a cell at pressure P (Mbar), temperature T (K) and density ratio eta:
+    the run's constant G, or the law's G(P, T, eta) for laws that have one (Steinberg-Guinan, PTW)."""
+
+
+def initial_hardening(strength):
+    """Johnson-Cook's A + B 0^n (Mbar), the cells' initial `hard`; 0 for `LawStrength` (unused)."""
+
+
+def _is_johnson_cook(strength):
+    return getattr(strength, "instance_class", None) is Strength
+
+
+@overload(plastic_return, inline="always")
+def _plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+                    material):
+    return johnson_cook_floored_return if _is_johnson_cook(strength) else law_return
+
+
+@overload(cell_shear_modulus, inline="always")
+def _cell_shear_modulus(strength, P, T, eta):
+    if _is_johnson_cook(strength):
+        return lambda strength, P, T, eta: strength.G
+    return lambda strength, P, T, eta: law_shear_modulus(strength.law, strength.G, P, T, eta)
+
+
+@overload(initial_hardening, inline="always")
+def _initial_hardening(strength):
+    if _is_johnson_cook(strength):
+        return lambda strength: hardening(strength.A, strength.B, strength.n, 0.0)
+    return lambda strength: 0.0
+
+
 @njit(cache=True, error_model="numpy")
 def energy_update(E, P, p_cold, q, dV, work_dev, g_rho0):
     """dE = -(P + q) dV + deviatoric work, P trapezoid-implicit: P_new = p_cold + g_rho0 E_new."""
@@ -300,17 +385,16 @@ def energy_update(E, P, p_cold, q, dV, work_dev, g_rho0):
 @njit(cache=True, error_model="numpy")
 def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, peaks):
     """Advance the active cells (those touching nodes lo..hi, the gap excepted) by dt: length and
-    strain rate from the node velocities, EOS sound speed, artificial viscosity, elastic trial and
-    Johnson-Cook return (skipped while the trial lies inside the cell's flow-stress floor), energy
-    and pressure. Returns (status, failed cell or -1, max CFL signal rate c / L (1/us), at least
-    cfl / dt_max); a failed cell keeps its state. `peaks` holds the target's running maxima of
-    plastic rate (1/us, a diagnostic only), temperature (K) and plastic strain."""
+    strain rate from the node velocities, the cell's shear modulus, EOS sound speed, artificial
+    viscosity, elastic trial and the law's return (`plastic_return`), energy and pressure. Returns
+    (status, failed cell or -1, max CFL signal rate c / L (1/us), at least cfl / dt_max); a failed
+    cell keeps its state. `peaks` holds the target's running maxima of plastic rate (1/us, a
+    diagnostic only), temperature (K) and plastic strain."""
     u = nodes.u
     mass, length, E, P, s, sigma = cells.mass, cells.length, cells.E, cells.P, cells.s, cells.sigma
     eps_p, hard, flow_floor, floor_hotter, floor_T = (cells.eps_p, cells.hard, cells.flow_floor, cells.floor_hotter,
                                                       cells.floor_T)
     N = E.shape[0] - 1
-    four_thirds_G = 4.0 * strength.G / 3.0
     g_rho0 = material.gamma0 * material.rho0
     max_signal_rate = numerics.cfl / numerics.dt_max
     for j in range(max(lo - 1, 0), min(hi, N) + 1):
@@ -322,24 +406,19 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
             return STATUS_NEGATIVE_VOLUME, j, max_signal_rate
         strain_rate = 2.0 * du / (length[j] + new_length)
         volume = new_length / mass[j]              # specific volume 1/rho
-        mu = 1.0 / (material.rho0 * volume) - 1.0
+        eta = 1.0 / (material.rho0 * volume)       # rho / rho0
+        mu = eta - 1.0
+        T_cell = material.T_ref + E[j] / material.cv
+        G = cell_shear_modulus(strength, P[j], T_cell, eta)
+        four_thirds_G = 4.0 * G / 3.0
         c_bulk_sq = bulk_sound_speed_sq(mu, P[j], volume, material.rho0, material.c1, material.c2, material.c3,
                                         material.gamma0)
         c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
-        T_cell = material.T_ref + E[j] / material.cv
-        floor = floor_at(T_cell, flow_floor[j], floor_hotter[j], floor_T[j])
-        if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
-            s_new, d_eps = s_trial, 0.0
-        else:
-            s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, hard[j],
-                                                                        strength, material)
-            if d_eps > 0.0:
-                eps_p[j] += d_eps
-                hard[j] = hardening(strength.A, strength.B, strength.n, eps_p[j])
-            floor_T[j] = T_cell
-            flow_floor[j], floor_hotter[j] = new_floors(hard[j], thermal, thermal_hotter)
+        s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j] = plastic_return(
+            s_trial, T_cell, strain_rate, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
+            strength, material)
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)
@@ -381,7 +460,7 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out)
         dx: cell size (cm).
         velocity: impact velocity of the flyer (cm/us).
         initial: `InitialState` of both plates (g/cc, (cm/us)^2).
-        strength: `Strength` (Mbar, -, 1/us).
+        strength: `Strength` (Johnson-Cook: Mbar, -, 1/us) or `LawStrength` (a law's tuple and G in Mbar).
         material: `Material` (code units).
         numerics: `Numerics` (artificial viscosity, CFL, time steps in us).
         t_out: output times (us), t_out[0] = 0.

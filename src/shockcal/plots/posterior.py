@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots, to_display
 
 # Gray et al. Johnson-Cook fits for Al-5083 (SPEC section 3), display units (A, B in MPa).
@@ -23,11 +24,17 @@ GRAY_STYLES = ("-", "--", "-.", ":")
 N_BINS = 40
 
 
+def _gray_sets(config: dict) -> dict:
+    """Gray et al.'s sets when the study calibrates Johnson-Cook (its A, B, C, n, m are inputs), else none:
+    another law's `n` is not Johnson-Cook's."""
+    return GRAY_SETS if set(JOHNSON_COOK_INPUTS) <= set(config["inputs"]) else {}
+
+
 def display_limits(name: str, config: dict) -> tuple[float, float]:
     """Prior box of input `name` in display units, widened to show any of Gray's values outside it."""
     box = config["inputs"][name]
     lo, hi = to_display(name, [box["min"], box["max"]])
-    refs = [s[name] for s in GRAY_SETS.values() if name in s]
+    refs = [s[name] for s in _gray_sets(config).values() if name in s]
     lo, hi = min([lo, *refs]), max([hi, *refs])
     pad = 0.02 * (hi - lo)
     return lo - pad, hi + pad
@@ -42,8 +49,8 @@ def _shade_outside_box(ax, name: str, config: dict) -> None:
     ax.axvspan(hi, right, color=COLORS["prior"], lw=0)
 
 
-def _gray_lines(ax, name: str) -> None:
-    for (label, values), ls in zip(GRAY_SETS.items(), GRAY_STYLES):
+def _gray_lines(ax, name: str, config: dict) -> None:
+    for (label, values), ls in zip(_gray_sets(config).items(), GRAY_STYLES):
         if name in values:
             ax.axvline(values[name], color=COLORS["reference"], ls=ls, lw=1.1, label=f"Gray et al.: {label}")
 
@@ -75,7 +82,7 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
                 ax.set_xlim(display_limits(name, config))
                 ax.set_yticks([])
                 _shade_outside_box(ax, name, config)
-                _gray_lines(ax, name)
+                _gray_lines(ax, name, config)
             if r == len(rows) - 1:
                 ax.set_xlabel(input_label(name))
             ax.tick_params(axis="x", labelsize=6.5)

@@ -14,8 +14,10 @@ from typing import TYPE_CHECKING
 
 from shockcal.design import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
+from shockcal.hydro.laws import get_law
 from shockcal.seeds import stream_seed
 from shockcal.study.config import end_time_us, prior_bounds, shot_config, velocity_box_m_s
+from shockcal.study.strength import DEFAULT_MODEL, strength_model
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -34,9 +36,16 @@ def input_box(config: dict) -> InputBox:
 
 
 def shot_mapping(config: dict, shot: str) -> ShotMapping:
-    """How `shot` reads a design row (`shots.<shot>`; a ConfigError names an unknown shot)."""
+    """How `shot` reads a design row (`shots.<shot>`, `strength.model` and the law's boxed parameters in
+    `inputs`; a ConfigError names an unknown shot)."""
     spec = shot_config(config, shot)
-    return ShotMapping(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
+    model = strength_model(config)
+    if model == DEFAULT_MODEL:
+        return ShotMapping(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
+    law = get_law(model)
+    modulus = () if law.shear_modulus is not None else tuple(spec["shear_modulus_inputs"])
+    return ShotMapping(shot, spec["velocity_input"], modulus, law.name,
+                       tuple(name for name in config["inputs"] if name in law.names()))
 
 
 def material_properties(config: dict) -> MaterialProperties:
@@ -81,11 +90,13 @@ def emulator_settings(config: dict) -> EmulatorSettings:
 
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
-    """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots`."""
+    """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
+    inputs eps^n and T*^m for Johnson-Cook only)."""
     from shockcal.emulator import POWER_INPUTS, EmulatorSpec
 
     section = config["emulator"]
-    powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key])
+    jc = strength_model(config) == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
+    powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key] and jc)
     return EmulatorSpec(section["structure"], {s: shot_mapping(config, s) for s in shots}, prior_bounds(config),
                         powers, emulator_settings(config))
 

@@ -24,7 +24,7 @@ from shockcal.study.config import shot_config
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
-_SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs")
+_SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "strength.model?")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
@@ -32,7 +32,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
     "check_design": ("study.seed", "inputs", "calibration.check.trials"),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto
-    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}",
+    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?",
                  *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
                  "shots.{shot}.analysis.window_after_arrival_us"),
     # features of one shot's traces (one chunk, or a whole run set with the failure budget)

@@ -18,6 +18,7 @@ from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import load_study_design
 from shockcal.study.config import velocity_box_m_s
+from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, strength_model
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
@@ -68,6 +69,7 @@ def validate_config(config: dict, source: str = "config") -> dict:
         _schema_validator().validate(config)
     except ValidationError as exc:
         raise ConfigError(f"{source}: {_schema_message(exc)}") from None
+    apply_strength_model(config, source)
     check_semantics(config, source)
     check_design_file(config, source)
     return config
@@ -127,14 +129,15 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for name, box in inputs.items():
         if not box["min"] < box["max"]:
             raise ConfigError(f"{source}: inputs.{name}: min ({box['min']}) must be below max ({box['max']})")
-    for name in JOHNSON_COOK_INPUTS:
+    for name in JOHNSON_COOK_INPUTS if strength_model(config) == DEFAULT_MODEL else ():
         if name not in inputs:
             raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {JOHNSON_COOK_INPUTS} are required")
         if inputs[name]["min"] < 0:
             raise ConfigError(f"{source}: inputs.{name}.min: Johnson-Cook parameters cannot be negative")
     for shot, spec in config["shots"].items():
         mapped = [("velocity_input", spec["velocity_input"])]
-        mapped += [(f"shear_modulus_inputs[{i}]", name) for i, name in enumerate(spec["shear_modulus_inputs"])]
+        mapped += [(f"shear_modulus_inputs[{i}]", name) for i, name in enumerate(spec["shear_modulus_inputs"])
+                   if not _law_has_modulus(config)]
         for key, name in mapped:
             if name not in inputs:
                 raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
@@ -175,6 +178,13 @@ def check_semantics(config: dict, source: str = "config") -> None:
                               f"{'published' if source_section == 'records' else 'records'}")
 
 
+def _law_has_modulus(config: dict) -> bool:
+    """Whether the study's law computes G itself (then the shots' shear-modulus inputs are not read)."""
+    from shockcal.hydro.laws import get_law
+
+    return get_law(strength_model(config)).shear_modulus is not None
+
+
 def check_initial_temperature(spec: dict, material: dict, where: str) -> None:
     """A shot's initial temperature (K) must lie below the material's melting temperature: the
     Johnson-Cook strength vanishes at T* = 1 and the plates would start molten."""
@@ -211,13 +221,14 @@ def check_window(config: dict, shot: str, source: str) -> None:
     surface (`shockcal.plausibility.release_times_us`, with the config's material and plates, and the
     largest shear modulus of the shot's prior box: the earliest release); a window reaching it would
     read the release as part of the plateau. Shear-modulus inputs in a unit other than
-    SHEAR_MODULUS_TO_MBAR's are not checked."""
+    SHEAR_MODULUS_TO_MBAR's are not checked. A law with its own G law (SG, PTW) uses its G0_GPa box's
+    maximum: the rise of G with pressure is left out, so this check is a little lenient for them."""
     spec, material = config["shots"][shot], config["material"]
-    units = [str(config["inputs"][name]["unit"]).strip() for name in spec["shear_modulus_inputs"]]
+    terms = ["G0_GPa"] if _law_has_modulus(config) else spec["shear_modulus_inputs"]
+    units = [str(config["inputs"][name]["unit"]).strip() for name in terms]
     if any(unit not in SHEAR_MODULUS_TO_MBAR for unit in units):
         return
-    g_max = sum(config["inputs"][name]["max"] * SHEAR_MODULUS_TO_MBAR[unit]
-                for name, unit in zip(spec["shear_modulus_inputs"], units))
+    g_max = sum(config["inputs"][name]["max"] * SHEAR_MODULUS_TO_MBAR[unit] for name, unit in zip(terms, units))
     arrival, release = release_times_us(spec["flyer_mm"], spec["target_mm"], material["rho0_g_cc"],
                                         material["eos"]["c1_Mbar"], g_max)
     window = spec["analysis"]["window_after_arrival_us"]

@@ -10,8 +10,8 @@ ignores what it does not depend on. Laws whose shear modulus varies also have
 `shear_modulus(law, P, T, eta) -> Mbar`. The laws: `johnson-cook` (today's hydrocode law, bit for
 bit), `steinberg-guinan`, `ptw` (Preston-Tonks-Wallace) and `zerilli-armstrong` (fcc). Their
 parameters, in user units with the conversion to code units, are declared in `declarations.py`;
-prior boxes for aluminium with sources in config/models.yaml (`boxes.py`). Not yet wired into the
-hydrocode: docs/strength_laws.md lists the solver's hook points.
+prior boxes for aluminium with sources in config/models.yaml (`boxes.py`). The solver calls them
+through `kernels.py` (`law_flow_stress`, `law_shear_modulus`); docs/strength_laws.md.
 """
 
 from __future__ import annotations

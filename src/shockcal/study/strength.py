@@ -1,0 +1,128 @@
+"""The study's strength law (config `strength`): the prior box it calibrates, checked before any run.
+
+With `strength.model` other than johnson-cook, `apply_strength_model` rewrites the validated config's
+`inputs` into the law's box (`strength.inputs`, else `strength.models_file`), each shot's velocity
+input and, for a law without a shear-modulus law, each shot's modulus inputs, so that every stage
+reads its box, names and units from `inputs` as for Johnson-Cook; `strength.inputs` then holds the
+whole box, so the rewritten config validates to itself (the workflow's jobs read it again).
+Johnson-Cook configs are left alone.
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+
+from shockcal.errors import ConfigError, InputError
+from shockcal.hydro import JOHNSON_COOK_INPUTS
+from shockcal.hydro.laws import flow_stress_curve, get_law
+from shockcal.hydro.laws.boxes import load_boxes
+
+DEFAULT_MODEL = "johnson-cook"
+# states at which a box's corners must give a finite, non-negative flow stress:
+# (plastic strain, equivalent strain rate 1/s, temperature K, pressure GPa, density ratio)
+CORNER_STATES = ((0.0, 1.0e-3, 298.0, 0.0, 1.0), (0.2, 1.0e6, 298.0, 5.0, 1.06), (0.5, 1.0e7, 600.0, 10.0, 1.1))
+MAX_CORNERS = 2 ** 16
+
+
+def strength_model(config: dict) -> str:
+    """The study's law (`strength.model`; johnson-cook when the section is left out)."""
+    return (config.get("strength") or {}).get("model", DEFAULT_MODEL)
+
+
+def apply_strength_model(config: dict, source: str) -> None:
+    """For a law other than Johnson-Cook: `inputs` becomes the law's box (declared units) followed by the
+    shots' velocity inputs and, for a law without a G law, their shear-modulus inputs; `calibration.cube_power`
+    drops Johnson-Cook's inputs. ConfigError naming the key: a parameter the law does not have, a missing
+    bound, min >= max, an input that is neither the law's nor a shot's, a box corner whose flow stress is
+    negative or not finite."""
+    model = strength_model(config)
+    if model == DEFAULT_MODEL:
+        return
+    law = get_law(model)
+    section = config["strength"]
+    given = section.get("inputs") or {}
+    for name in given:
+        if name not in law.names():
+            raise ConfigError(f"{source}: strength.inputs.{name}: not a parameter of {law.name} "
+                              f"(parameters: {', '.join(law.names())})")
+    models_file = section.get("models_file", "config/models.yaml")
+    file_box = _file_box(models_file, law.name, source) if any(
+        p.default is None and p.name not in given for p in law.params) else {}
+    box = {}
+    for param in law.params:
+        if param.name in given:
+            low, high, where = given[param.name]["min"], given[param.name]["max"], f"strength.inputs.{param.name}"
+        elif param.name in file_box:
+            low, high, where = file_box[param.name].low, file_box[param.name].high, f"{models_file}: {law.name}.{param.name}"
+        elif param.default is None:
+            raise ConfigError(f"{source}: strength.inputs.{param.name}: missing; {law.name} needs a box for it "
+                              f"(give min and max, or a low/high in {models_file})")
+        else:
+            continue
+        if not low < high:
+            raise ConfigError(f"{source}: {where}: min ({low}) must be below max ({high})")
+        box[param.name] = {"min": float(low), "max": float(high), "unit": param.unit}
+    check_corners(law, box, source)
+    config["inputs"] = {**box, **_shot_inputs(config, law, given, source)}
+    section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
+    cube = config["calibration"]["cube_power"]
+    config["calibration"]["cube_power"] = {k: v for k, v in cube.items() if k not in JOHNSON_COOK_INPUTS}
+
+
+def _file_box(path: str, law_name: str, source: str) -> dict:
+    if not Path(path).is_file():
+        raise ConfigError(f"{source}: strength.models_file: {path} does not exist")
+    return load_boxes(path).get(law_name, {})
+
+
+def _shot_inputs(config: dict, law, given: dict, source: str) -> dict:
+    """The config's inputs the shots read under `law`: velocities, and modulus terms for a law without a G law;
+    Johnson-Cook's five (the paper's) are dropped, and so is a law parameter that `given` (strength.inputs)
+    boxes with the same bounds (a config this function wrote, read again by a job); anything else is an
+    error naming it."""
+    shots = config["shots"].values()
+    velocity = {spec["velocity_input"] for spec in shots}
+    modulus = {name for spec in shots for name in spec["shear_modulus_inputs"]}
+    kept = velocity | (modulus if law.shear_modulus is None else set())
+    out = {}
+    for name, spec in config["inputs"].items():
+        if name in kept:
+            out[name] = spec
+        elif name in JOHNSON_COOK_INPUTS or name in modulus:
+            continue
+        elif name in given and (given[name]["min"], given[name]["max"]) == (spec["min"], spec["max"]):
+            continue
+        elif name in law.names():
+            raise ConfigError(f"{source}: inputs.{name}: a {law.name} parameter; give its box as strength.inputs.{name}")
+        else:
+            raise ConfigError(f"{source}: inputs.{name}: neither a {law.name} parameter nor a shot's velocity"
+                              f"{' or shear-modulus' if law.shear_modulus is None else ''} input")
+    return out
+
+
+def check_corners(law, box: dict, source: str) -> None:
+    """Every corner of the law's box (parameters outside the box at their defaults) must meet the law's
+    constraints (all linear: SG's Ymax >= Y0, PTW's ordering of s0, sinf, y0, yinf, y1, ...; so the
+    whole box meets them), and give a finite, non-negative flow stress at CORNER_STATES: a ConfigError
+    naming the corner otherwise."""
+    names = list(box)
+    if 2 ** len(names) > MAX_CORNERS:
+        raise ConfigError(f"{source}: strength.inputs: {len(names)} boxed parameters; at most "
+                          f"{MAX_CORNERS.bit_length() - 1} (the box's corners are checked)")
+    defaults = {p.name: p.default for p in law.params if p.default is not None}
+    for corner in itertools.product(*((box[n]["min"], box[n]["max"]) for n in names)):
+        values = {**defaults, **dict(zip(names, corner))}
+        where = ", ".join(f"{n}={v:g}" for n, v in zip(names, corner))
+        try:
+            stresses = [flow_stress_curve(law, values, [eps], rate, T, P, eta)[0]
+                        for eps, rate, T, P, eta in CORNER_STATES]
+        except InputError as exc:
+            raise ConfigError(f"{source}: strength: the box's corner {where} breaks the law ({exc}); the law's "
+                              "constraints are linear, so boxes that meet them at every corner meet them inside") from None
+        bad = [s for s in stresses if not (np.isfinite(s) and s >= 0.0)]
+        if bad:
+            raise ConfigError(f"{source}: strength: {law.name}'s flow stress is {bad[0]:g} MPa at the box corner "
+                              f"{where}; narrow the box (strength.inputs)")
