@@ -290,14 +290,14 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
 
 # Measured records against the features published with the paper (observed_features.csv, the paper's
 # own extractor). Bounds are just above the measured differences where those are within the issue's
-# worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a noisy plateau: -232,
-# -45 and -38 ns). Cases beyond the worst case keep that bound and are xfail with the measured
-# difference. With EM run to convergence from fixed starts, jump-off and elastic times agree within
-# 1.1 ns in every shot (the seeded, default-tolerance fit was 24-29 ns off in 105S and 106S).
+# worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a slowly rising noisy
+# plateau: -262, +86 and +302 ns with the isotonic fit). Cases beyond the worst case keep that bound and
+# are xfail with the measured difference. Read robustly (isotonic fit, local linear reads over the
+# record's noise window, 2026-11-26), jump-off and elastic times agree within 0.9 ns in every shot.
 WORST_CASE = (3.0, 0.010)  # m/s, us
-BOUNDS = {"104S": (2.1, 0.004), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
+BOUNDS = {"104S": (2.4, 0.0075), "105S": (2.4, 0.0025), "106S": (2.2, 0.0030)}
 BEYOND = {  # measured (ours - published), m/s
-    ("105S", "v_plastic"): 7.11, ("106S", "v_plastic"): 3.21, ("106S", "v_slope1"): 4.74,
+    ("105S", "v_plastic"): 4.76, ("106S", "v_elastic"): -3.28,
 }
 
 

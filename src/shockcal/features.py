@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import optimize, stats
 from scipy.optimize import isotonic_regression
+from scipy.signal import savgol_filter
 
 from shockcal.errors import InputError, ShockcalError
 
@@ -319,9 +320,11 @@ def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, samples: np.
 
 def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed: int, robust: bool | None = None
                        ) -> pd.DataFrame:
-    """The features of `replicates` copies of a noisy trace, each with an independent replicate of its
-    own noise added (a parametric bootstrap: `shockcal.record_noise`, the AR model fitted to the
-    trace's plateau residuals). Their spread is the extractor's read-out error on the trace.
+    """The features of `replicates` copies of a noisy trace's signal, each with an independent replicate
+    of its noise added: a parametric bootstrap. The signal is the trace smoothed by the read-out's own
+    local line (scipy's Savitzky-Golay filter of order 1 over the read-out window), the noise the AR
+    model fitted to the trace's plateau residuals (`shockcal.record_noise`). Their spread is the
+    extractor's read-out error on the trace.
 
     Args:
         t, v: the trace (us, m/s); it must be noisy (not at rest before its rise: a simulation has no
@@ -341,11 +344,13 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     noise = extract(t, v, settings).noise
     if noise is None:
         raise FeatureError("the trace is at rest before its rise (noise-free): it has no noise to replicate")
+    half_width = max(int(round(noise.half_window_us / np.median(np.diff(t)))), 1)
+    signal = savgol_filter(v, 2 * half_width + 1, 1)
     rng = np.random.default_rng(seed)
     rows = []
     for _ in range(replicates):
         try:
-            rows.append(extract(t, v + noise.simulate(len(v), rng), settings, robust=robust).features)
+            rows.append(extract(t, signal + noise.simulate(len(v), rng), settings, robust=robust).features)
         except FeatureError:
             continue
     return pd.DataFrame(rows, columns=COLUMNS)
