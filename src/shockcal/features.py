@@ -11,8 +11,9 @@
    (per shot in config; it must end before the release from the flyer's back reaches the free
    surface). Measured records carry pre-trigger content and a baseline offset: both are outside
    the window or removed by the standardization below.
-3. The windowed trace is standardized to run from 0 to 1, made monotone (running maximum) and read
-   as a CDF; 10,000 samples are drawn by the probability integral transform: stratified uniform
+3. The windowed trace is standardized to run from 0 to 1, made monotone and read as a CDF (a
+   noise-free trace: the running maximum; a noisy one, `is_noisy`: its isotonic regression, which does
+   not climb to the noise peaks); 10,000 samples are drawn by the probability integral transform: stratified uniform
    draws u_i = (i + 1/2)/N (no random numbers) mapped through the inverse CDF, linear interpolation
    of (y, t). The samples move smoothly with the trace, so neighbouring runs get neighbouring samples.
    Their distribution is known exactly: uniform between consecutive (t, y) pairs where y rises.
@@ -34,7 +35,10 @@
    and a stand-in early component's jump-off and elastic times inside [window start, cut-off].
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
-   trace reaches 0.995. Each velocity is the trace's value at that time.
+   trace reaches 0.995. Each velocity is the trace's value at that time (a noisy trace: the value of a
+   least-squares line over the record's read-out window, `shockcal.record_noise`).
+6. A noisy trace's read-out error: the spread of its features over replicates of its noise
+   (`readout_replicates`, `readout_sd`), which the calibration adds to the 1% observation sd.
 """
 
 from __future__ import annotations
