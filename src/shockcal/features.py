@@ -331,8 +331,7 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     extractor's read-out error on the trace.
 
     Args:
-        t, v: the trace (us, m/s); it must be noisy (not at rest before its rise: a simulation has no
-            noise to replicate).
+        t, v: the trace (us, m/s); it must be noisy (`is_noisy`: a simulation has no noise to replicate).
         settings: the shot's `ExtractorSettings`.
         replicates: how many noise replicates.
         seed: seeds the replicates (`numpy.random.default_rng`).
@@ -347,7 +346,7 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
     noise = extract(t, v, settings).noise
     if noise is None:
-        raise FeatureError("the trace is at rest before its rise (noise-free): it has no noise to replicate")
+        raise FeatureError("the trace is noise-free before its arrival (a simulation): it has no noise to replicate")
     half_width = max(int(round(noise.half_window_us / np.median(np.diff(t)))), 1)
     signal = savgol_filter(v, 2 * half_width + 1, 1)
     rng = np.random.default_rng(seed)
