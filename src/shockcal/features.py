@@ -68,7 +68,7 @@ QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0
 PRE_ARRIVAL_US = 0.05
 PLASTIC_LEVEL = 0.995
-NOISE_FLOOR = 1e-4          # a trace is noisy (read robustly) above this robust sd before arrival, share of its rise
+NOISE_FLOOR = 1e-4          # a trace is noisy (read robustly) above this robust sd before arrival, share of its range
 NOISE_PLATEAU_LEVEL = 0.97  # a record's noise is estimated where its monotone fit has passed this level
 MIXTURE_STARTS = 3         # EM starts: quantile-spaced means, then k-means seeded 0, 1, ...
 MIXTURE_TOL = 1e-5         # EM stops when the mean log-likelihood gains less than this
@@ -204,11 +204,11 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
     return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early, noise)
 
 
-def is_noisy(v_before_arrival: np.ndarray, rise_m_s: float) -> bool:
+def is_noisy(v_before_arrival: np.ndarray, range_m_s: float) -> bool:
     """Whether the trace just before its arrival (the window's first `PRE_ARRIVAL_US`) has a robust sd
-    (1.4826 x MAD) above `NOISE_FLOOR` of its rise: a record's (0.7-2.4 m/s, 3e-3 to 5e-3 of the rise),
+    (1.4826 x MAD) above `NOISE_FLOOR` of its range: a record's (0.8-2.3 m/s, 2.5e-3 to 4.7e-3 of it),
     not a simulation's (at rest: 0) nor an analytic trace's."""
-    return float(stats.median_abs_deviation(v_before_arrival, scale="normal")) > NOISE_FLOOR * rise_m_s
+    return float(stats.median_abs_deviation(v_before_arrival, scale="normal")) > NOISE_FLOOR * range_m_s
 
 
 def monotone_cdf(v_window: np.ndarray, robust: bool) -> np.ndarray:
