@@ -114,6 +114,18 @@ def test_bad_observed_features_are_rejected(table, message):
         observed_vector(table, ["S"], ["v_elastic", "v_plastic"], "obs.csv")
 
 
+def test_readout_sd_adds_to_the_observation_sd_in_quadrature():
+    """The observed table's read-out sds (m/s) join the 1% in quadrature; a table without them is the 1%
+    alone; a negative one is an error naming the shot and the column."""
+    emulator = StandInEmulator(lambda t: 100.0 + 0 * t, ["a"], [0], [1], 0.25 * np.eye(2))
+    plain = Problem.for_shots(emulator, ["S"], _observed([60.0, 200.0]), 0.01)
+    assert plain.obs_sd == pytest.approx([0.6, 2.0])
+    table = _observed([60.0, 200.0]).assign(readout_sd_v_elastic=0.8, readout_sd_v_plastic=0.0)
+    assert Problem.for_shots(emulator, ["S"], table, 0.01).obs_sd == pytest.approx([1.0, 2.0])
+    with pytest.raises(InputError, match="shot S: readout_sd_v_plastic"):
+        Problem.for_shots(emulator, ["S"], table.assign(readout_sd_v_plastic=-1.0), 0.01, "obs.csv")
+
+
 def test_calibrate_returns_draws_summary_and_evidence(paper_config):
     emulator = StandInEmulator(lambda t: np.column_stack([100 + 50 * t[:, 0] ** 2, 80 + 20 * t[:, 0] ** 2]),
                                ["A"], [-1], [1], 0.01 * np.eye(2))

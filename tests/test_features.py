@@ -15,6 +15,7 @@ from shockcal.features import (
     Mixture,
     extract,
     extract_features,
+    feature_times,
     feature_values,
     features_table,
     fit_mixture,
@@ -131,7 +132,7 @@ def test_a_precursor_without_a_component_of_its_own_is_read_inside_the_elastic_p
     cutoff = 1.04
     early = split_early(mixture, cutoff)
     assert early.tolist() == [True, False, False]      # the fallback: no component ends before the cut-off
-    features = feature_values(T, v, T[window], cdf, mixture, early, cutoff)
+    features = feature_values(T, v, feature_times(T[window], cdf, mixture, early, cutoff))
     assert features["t_elastic"] == cutoff and features["v_elastic"] == pytest.approx(7.0, abs=0.01)
     assert features["t_jumpoff"] == pytest.approx(0.95)
     assert 7.0 < features["v_slope1"] < features["v_slope2"] < 467.0
@@ -179,20 +180,22 @@ def test_baseline_offset_moves_velocities_by_the_offset_only(settings, offset):
 NOISE_REALIZATIONS = 10
 
 
-@pytest.mark.parametrize("plateau", [
-    "elastic",
-    pytest.param("plastic", marks=pytest.mark.xfail(strict=True, reason=(
-        "v_plastic moves +3.8 m/s on average (3.1 to 4.4) under 1 m/s white noise, measured: the "
-        "window's max is a noise peak, so the 0.995 crossing is read on a noise excursion"))),
+@pytest.mark.parametrize("plateau, robust", [
+    ("elastic", None), ("plastic", None), ("elastic", False),
+    pytest.param("plastic", False, marks=pytest.mark.xfail(strict=True, reason=(
+        "the running maximum (the read before 2026-11-26): v_plastic moves +3.8 m/s on average (3.1 to 4.4) "
+        "under 1 m/s white noise, measured: the window's max is a noise peak, so the 0.995 crossing is read "
+        "on a noise excursion"))),
 ])
-def test_noise_moves_plateaus_by_at_most_two_m_s(settings, plateau):
-    """1 m/s seeded Gaussian noise: the mean shift of a plateau velocity over 10 realizations.
+def test_noise_moves_plateaus_by_at_most_two_m_s(settings, plateau, robust):
+    """1 m/s seeded Gaussian noise: the mean shift of a plateau velocity over 10 realizations, read
+    robustly (a noisy trace's default: isotonic fit, local linear reads) or as a noise-free trace.
 
     Each velocity is one noisy sample (sd 1 m/s), so the mean of 10 has sd 0.32 m/s: a shift above
     2 m/s is the extractor's, not the draw's.
     """
     clean = features(trace(), settings)[f"v_{plateau}"]
-    shifts = [features(trace(noise_sd=1.0, noise_seed=k), settings)[f"v_{plateau}"] - clean
+    shifts = [extract(T, trace(noise_sd=1.0, noise_seed=k), settings, robust=robust).features[f"v_{plateau}"] - clean
               for k in range(NOISE_REALIZATIONS)]
     assert abs(np.mean(shifts)) <= 2.0
 
@@ -287,14 +290,14 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
 
 # Measured records against the features published with the paper (observed_features.csv, the paper's
 # own extractor). Bounds are just above the measured differences where those are within the issue's
-# worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a noisy plateau: -232,
-# -45 and -38 ns). Cases beyond the worst case keep that bound and are xfail with the measured
-# difference. With EM run to convergence from fixed starts, jump-off and elastic times agree within
-# 1.1 ns in every shot (the seeded, default-tolerance fit was 24-29 ns off in 105S and 106S).
+# worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a slowly rising noisy
+# plateau: -262, +86 and +302 ns with the isotonic fit). Cases beyond the worst case keep that bound and
+# are xfail with the measured difference. Read robustly (isotonic fit, local linear reads over the
+# record's noise window, 2026-11-26), jump-off and elastic times agree within 0.9 ns in every shot.
 WORST_CASE = (3.0, 0.010)  # m/s, us
-BOUNDS = {"104S": (2.1, 0.004), "105S": (1.8, 0.0025), "106S": (2.5, 0.0055)}
+BOUNDS = {"104S": (2.4, 0.0075), "105S": (2.4, 0.0025), "106S": (2.2, 0.0030)}
 BEYOND = {  # measured (ours - published), m/s
-    ("105S", "v_plastic"): 7.11, ("106S", "v_plastic"): 3.21, ("106S", "v_slope1"): 4.74,
+    ("105S", "v_plastic"): 4.76, ("106S", "v_elastic"): -3.28,
 }
 
 
@@ -317,7 +320,7 @@ def record_differences(paper_config_readonly):
     return {shot: {column: value - published.loc[shot, column]
                    for column, value in record_features(DATA / "visar" / f"Data_S{shot}.txt",
                                                         extractor_settings(paper_config_readonly, shot),
-                                                        shot).items()}
+                                                        shot).items() if column in COLUMNS}
             for shot in BOUNDS}
 
 
@@ -394,7 +397,7 @@ def test_slope_times_stay_inside_the_window_when_the_late_mixture_is_one_broad_c
     """A single-wave trace (large A) can leave EM one broad component of a few 1e-5 of the mass spread
     over the plateau; its 0.9 quantile lies past the window, where the release has come: the slope times
     are read at the window's end instead (the study's 104S runs 349 and 748 read v_slope2 = 0.001 m/s)."""
-    from shockcal.features import Mixture, feature_values
+    from shockcal.features import Mixture, feature_times, feature_values
 
     t = np.linspace(0.0, 2.4, 4801)
     v = np.where(t < 0.88, 0.0, 213.0) * (t < 2.2)           # one wave, then the release at 2.2 us
@@ -402,6 +405,6 @@ def test_slope_times_stay_inside_the_window_when_the_late_mixture_is_one_broad_c
     cdf = np.clip((t_window - 0.83) / 0.06, 0.0, 1.0)
     mixture = Mixture(np.array([0.6, 0.39993, 7e-5]), np.array([0.882, 0.885, 1.76]), np.array([0.004, 0.003, 0.41]))
     early = np.array([True, True, False])
-    features = feature_values(t, v, t_window, cdf, mixture, early, cutoff_us=0.92)
+    features = feature_values(t, v, feature_times(t_window, cdf, mixture, early, cutoff_us=0.92))
     assert features["t_slope2"] <= t_window[-1] and features["t_slope1"] <= features["t_slope2"]
     assert features["v_slope1"] == features["v_slope2"] == 213.0

@@ -11,8 +11,9 @@
    (per shot in config; it must end before the release from the flyer's back reaches the free
    surface). Measured records carry pre-trigger content and a baseline offset: both are outside
    the window or removed by the standardization below.
-3. The windowed trace is standardized to run from 0 to 1, made monotone (running maximum) and read
-   as a CDF; 10,000 samples are drawn by the probability integral transform: stratified uniform
+3. The windowed trace is standardized to run from 0 to 1, made monotone and read as a CDF (a
+   noise-free trace: the running maximum; a noisy one, `is_noisy`: its isotonic regression, which does
+   not climb to the noise peaks); 10,000 samples are drawn by the probability integral transform: stratified uniform
    draws u_i = (i + 1/2)/N (no random numbers) mapped through the inverse CDF, linear interpolation
    of (y, t). The samples move smoothly with the trace, so neighbouring runs get neighbouring samples.
    Their distribution is known exactly: uniform between consecutive (t, y) pairs where y rises.
@@ -34,7 +35,10 @@
    and a stand-in early component's jump-off and elastic times inside [window start, cut-off].
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
-   trace reaches 0.995. Each velocity is the trace's value at that time.
+   trace reaches 0.995. Each velocity is the trace's value at that time (a noisy trace: the value of a
+   least-squares line over the record's read-out window, `shockcal.record_noise`).
+6. A noisy trace's read-out error: the spread of its features over replicates of its noise
+   (`readout_replicates`, `readout_sd`), which the calibration adds to the 1% observation sd.
 """
 
 from __future__ import annotations
@@ -45,6 +49,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import optimize, stats
+from scipy.optimize import isotonic_regression
+from scipy.signal import savgol_filter
 
 from shockcal.errors import InputError, ShockcalError
 
@@ -55,11 +61,15 @@ log = logging.getLogger("shockcal.features")
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]   # what the emulator and calibration use
+READOUT_COLUMNS = [f"readout_sd_{column}" for column in CALIBRATION_FEATURES]   # m/s, in the observed table
+RECORD_NOISE_COLUMNS = ["noise_sd_m_s", "noise_ar_order", "readout_half_window_ns"]
 ARRIVAL_FRACTION = 0.02
 QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0
 PRE_ARRIVAL_US = 0.05
 PLASTIC_LEVEL = 0.995
+NOISE_FLOOR = 1e-4          # a trace is noisy (read robustly) above this robust sd before arrival, share of its range
+NOISE_PLATEAU_LEVEL = 0.97  # a record's noise is estimated where its monotone fit has passed this level
 MIXTURE_STARTS = 3         # EM starts: quantile-spaced means, then k-means seeded 0, 1, ...
 MIXTURE_TOL = 1e-5         # EM stops when the mean log-likelihood gains less than this
 MIXTURE_MAX_ITER = 1000
@@ -102,6 +112,7 @@ class Extraction:
     samples: np.ndarray      # PIT samples (us)
     mixture: Mixture
     early: np.ndarray        # boolean mask of early components
+    noise: object = None     # the record's NoiseModel (shockcal.record_noise) when read robustly, else None
 
 
 def baseline_and_noise(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
@@ -144,7 +155,8 @@ class ExtractorSettings:
     n_samples: int = 10000
 
 
-def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str = "exact") -> Extraction:
+def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str = "exact",
+            robust: bool | None = None) -> Extraction:
     """Run the extractor on one trace; raises FeatureError when it cannot.
 
     Args:
@@ -155,6 +167,10 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
             from starts made from the n_samples PIT samples); "pit" (the reference, 30-90 times slower)
             fits it by scikit-learn's EM to the samples (`fit_mixture`). Both draw the samples: the
             figures show them.
+        robust: the noisy-trace read (isotonic monotone fit, velocities from local linear fits over the
+            record's noise window, `shockcal.record_noise`) or the noise-free one (running maximum,
+            velocities interpolated between two samples). None (default): robust when the trace is
+            noisy before its arrival (`is_noisy`), so simulated traces are read as before.
 
     Returns:
         An `Extraction`: the ten features (times us, velocities m/s) and the intermediate steps.
@@ -165,11 +181,12 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
         raise FeatureError(f"{int(bad.sum())} non-finite values in the trace (first at index {int(np.argmax(bad))})")
     arrival = detect_arrival(t, v)
     start, end = arrival - PRE_ARRIVAL_US, arrival + settings.window_after_arrival_us
+    robust = is_noisy(v[(t >= start) & (t < arrival)], np.ptp(v)) if robust is None else robust
     if end > t[-1]:
         raise FeatureError(f"trace ends at {t[-1]:.3f} us, before the analysis window ({end:.3f} us)")
     inside = (t >= start) & (t <= end)
     tw, vw = t[inside], v[inside]
-    y = np.maximum.accumulate((vw - vw.min()) / (vw.max() - vw.min()))
+    y = monotone_cdf(vw, robust)
     rising = np.diff(y, prepend=-1.0) > 0
     n = settings.n_samples
     samples = np.interp((np.arange(n) + 0.5) / n, y[rising], tw[rising])
@@ -181,8 +198,38 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
         raise ValueError(f"unknown mixture fit {method!r}: 'exact' or 'pit'")
     cutoff = arrival + settings.cutoff_after_arrival_us
     early = split_early(mixture, cutoff)
-    features = feature_values(t, v, tw, y, mixture, early, cutoff)
-    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early)
+    times = feature_times(tw, y, mixture, early, cutoff)
+    noise = record_noise(t, v, float(tw[np.argmax(y >= NOISE_PLATEAU_LEVEL)]), end) if robust else None
+    features = feature_values(t, v, times, 0.0 if noise is None else noise.half_window_us)
+    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early, noise)
+
+
+def is_noisy(v_before_arrival: np.ndarray, range_m_s: float) -> bool:
+    """Whether the trace just before its arrival (the window's first `PRE_ARRIVAL_US`) has a robust sd
+    (1.4826 x MAD) above `NOISE_FLOOR` of its range: a record's (0.8-2.3 m/s, 2.5e-3 to 4.7e-3 of it),
+    not a simulation's (at rest: 0) nor an analytic trace's."""
+    return float(stats.median_abs_deviation(v_before_arrival, scale="normal")) > NOISE_FLOOR * range_m_s
+
+
+def monotone_cdf(v_window: np.ndarray, robust: bool) -> np.ndarray:
+    """The windowed trace standardized to run from 0 to 1 and made non-decreasing: its isotonic
+    regression (the least-squares monotone fit, scipy) when `robust`, else the running maximum of
+    (v - min) / (max - min), which on a noisy record climbs to the highest noise peak."""
+    if robust:
+        fit = isotonic_regression(v_window).x
+        return (fit - fit[0]) / (fit[-1] - fit[0])
+    return np.maximum.accumulate((v_window - v_window.min()) / (v_window.max() - v_window.min()))
+
+
+def record_noise(t, v, plateau_start_us: float, end_us: float):
+    """The trace's noise model from its plateau (`shockcal.record_noise.estimate_noise`); a FeatureError
+    when the plateau is too short to estimate it."""
+    from shockcal.record_noise import estimate_noise
+
+    try:
+        return estimate_noise(t, v, plateau_start_us, end_us)
+    except ValueError as exc:
+        raise FeatureError(str(exc)) from None
 
 
 def ends_before(mixture: Mixture, cutoff_us: float) -> np.ndarray:
@@ -201,8 +248,8 @@ def split_early(mixture: Mixture, cutoff_us: float) -> np.ndarray:
     return early
 
 
-def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarray, cutoff_us: float) -> dict:
-    """The ten feature values (times us, velocities m/s) from the mixture split into early and late.
+def feature_times(t_window, cdf_window, mixture: Mixture, early: np.ndarray, cutoff_us: float) -> dict:
+    """The five feature times (us) from the mixture split into early and late.
 
     When no component lies before the cut-off (a precursor too small for EM to give it a component of
     its own: a few m/s ahead of the plastic wave at small A), the stand-in early component is broad,
@@ -218,14 +265,29 @@ def feature_values(t, v, t_window, cdf_window, mixture: Mixture, early: np.ndarr
         jumpoff, elastic = max(jumpoff, t_window[0]), min(elastic, cutoff_us)
     end = t_window[-1]        # a single wave's late mixture can be one broad component of a few 1e-5 of the
     slope1 = min(max(late_mix.quantile(0.1), elastic), end)     # mass spread over the plateau: it reaches back
-    times = {"jumpoff": jumpoff, "elastic": elastic,                # before the elastic time and past the window
-             "slope1": slope1, "slope2": min(max(late_mix.quantile(0.9), slope1), end),
-             "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
+    return {"jumpoff": float(jumpoff), "elastic": float(elastic),   # before the elastic time and past the window
+            "slope1": float(slope1), "slope2": float(min(max(late_mix.quantile(0.9), slope1), end)),
+            "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
+
+
+def feature_values(t, v, times: dict, half_window_us: float = 0.0) -> dict:
+    """The ten feature values: the times (us) and the trace's velocity at each (m/s, `read_velocity`)."""
     features = {}
     for name in FEATURES:
-        features[f"t_{name}"] = float(times[name])
-        features[f"v_{name}"] = float(np.interp(times[name], t, v))
+        features[f"t_{name}"] = times[name]
+        features[f"v_{name}"] = read_velocity(t, v, times[name], half_window_us)
     return features
+
+
+def read_velocity(t, v, time_us: float, half_window_us: float) -> float:
+    """The trace's velocity (m/s) at `time_us`: the value at `time_us` of a least-squares line through
+    the samples within `half_window_us` of it (a record's noise window), or, when that window holds
+    fewer than three samples (a noise-free trace: `half_window_us` 0), the linear interpolation
+    between the two samples around it."""
+    near = np.abs(t - time_us) <= half_window_us * (1 + 1e-9)
+    if near.sum() < 3:
+        return float(np.interp(time_us, t, v))
+    return float(np.polyfit(t[near] - time_us, v[near], 1)[1])
 
 
 def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
@@ -258,6 +320,43 @@ def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, samples: np.
     (weights, means, sds), _ = fit_piecewise_linear_cdf(t_window, cdf_window, n_components, MIXTURE_STARTS,
                                                         MIXTURE_TOL, MIXTURE_MAX_ITER, starts=samples)
     return Mixture(weights, means, sds)
+
+
+def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed: int, robust: bool | None = None
+                       ) -> pd.DataFrame:
+    """The features of `replicates` copies of a noisy trace's signal, each with an independent replicate
+    of its noise added: a parametric bootstrap. The signal is the trace smoothed by the read-out's own
+    local line (scipy's Savitzky-Golay filter of order 1 over the read-out window), the noise the AR
+    model fitted to the trace's plateau residuals (`shockcal.record_noise`). Their spread is the
+    extractor's read-out error on the trace.
+
+    Args:
+        t, v: the trace (us, m/s); it must be noisy (`is_noisy`: a simulation has no noise to replicate).
+        settings: the shot's `ExtractorSettings`.
+        replicates: how many noise replicates.
+        seed: seeds the replicates (`numpy.random.default_rng`).
+        robust: passed to `extract` for the replicates (None: robust, as for the trace itself).
+
+    Returns:
+        One row per replicate that has features, the ten feature columns (a replicate without features
+        is left out).
+    """
+    import pandas as pd
+
+    t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    noise = extract(t, v, settings).noise
+    if noise is None:
+        raise FeatureError("the trace is noise-free before its arrival (a simulation): it has no noise to replicate")
+    half_width = max(int(round(noise.half_window_us / np.median(np.diff(t)))), 1)
+    signal = savgol_filter(v, 2 * half_width + 1, 1)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(replicates):
+        try:
+            rows.append(extract(t, signal + noise.simulate(len(v), rng), settings, robust=robust).features)
+        except FeatureError:
+            continue
+    return pd.DataFrame(rows, columns=COLUMNS)
 
 
 def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) -> dict:
@@ -314,16 +413,40 @@ def _trace_column(record: dict, column: str, source) -> np.ndarray:
     return values
 
 
-def record_features(path, settings: ExtractorSettings, shot: str, time_column=None, velocity_column=None) -> dict:
+def readout_sd(values) -> float:
+    """The read-out sd (m/s) of a feature's replicates: 1.4826 x their median absolute deviation
+    (scipy), the sd of the body of their distribution. A replicate whose mixture splits another way
+    (105S: 1 in 20 reads v_elastic 30 m/s low) would otherwise set it; the record's own read is one
+    of the body, not of the rare split."""
+    return float(stats.median_abs_deviation(np.asarray(values, dtype=float), scale="normal"))
+
+
+def record_features(path, settings: ExtractorSettings, shot: str, time_column=None, velocity_column=None,
+                    replicates: int = 0, seed: int = 0) -> dict:
     """The ten features of a measured record (`shockcal.records.read_record`) of `shot`; an InputError
-    naming the record and the shot when it has none."""
+    naming the record and the shot when it has none.
+
+    With `replicates` > 0, also each calibration feature's read-out sd on the record
+    (`readout_sd_<feature>`, m/s: the sd over that many replicates of the record's noise, seeded by
+    `seed`; `readout_replicates`) and the noise model it came from (`noise_sd_m_s`, `noise_ar_order`,
+    `readout_half_window_ns`); with 0, only the read-out window and the noise sd, and read-out sds of 0.
+    """
     from shockcal.records import read_record
 
     t, v = read_record(path, _column(time_column), _column(velocity_column))
     try:
-        return extract_features(t, v, settings)
+        extraction = extract(t, v, settings)
+        copies = readout_replicates(t, v, settings, replicates, seed) if replicates else None
     except FeatureError as exc:
         raise InputError(f"record {path}: no features for shot {shot}: {exc}") from exc
+    noise = extraction.noise
+    row = dict(extraction.features)
+    for column in CALIBRATION_FEATURES:
+        row[f"readout_sd_{column}"] = 0.0 if copies is None else readout_sd(copies[column])
+    row.update(noise_sd_m_s=np.nan if noise is None else noise.sd_m_s,
+               noise_ar_order=0 if noise is None else len(noise.ar),
+               readout_half_window_ns=0.0 if noise is None else 1e3 * noise.half_window_us)
+    return row
 
 
 def _column(value):

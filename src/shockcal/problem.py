@@ -6,8 +6,9 @@ For the shots calibrated together, the measured features y (m/s, four per shot) 
 
 eta and C_eta the emulator's predictive mean and covariance, (nu, s) its error model (a Student t
 fitted to its K-fold errors, `shockcal.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
-e per emulator block (their errors are independent), Sigma_y diagonal with sd =
-`observed.sd_fraction` (1%) of each measured feature, lambda_y ~ Gamma(5, 5), theta uniform on the
+e per emulator block (their errors are independent), Sigma_y diagonal with variance
+(`observed.sd_fraction` y)^2 + r^2 for each measured feature y (1%, and r the extractor's read-out sd on
+the record, `readout_sd_<feature>` in the observed table), lambda_y ~ Gamma(5, 5), theta uniform on the
 prior box. The emulator's hyperparameters are fixed at their fitted mode (modular Bayes; see
 docs/calibration.md). A point is (theta in native units, lambda_y); both priors are reached from the
 unit cube (`Problem.prior_transform`).
@@ -77,7 +78,9 @@ class Problem:
         Args:
             emulator: the study's `Emulator` (design inputs in native units).
             shots: the shots calibrated together (one: a single-shot calibration; a shot twice is an error).
-            observed_table: measured features, one row per shot (m/s).
+            observed_table: measured features, one row per shot (m/s); a column `readout_sd_<feature>`
+                (m/s, the extractor's read-out sd on the record: `shockcal observed`) adds to the
+                feature's observation sd in quadrature (absent: 0).
             sd_fraction: observation sd as a fraction of each measured feature.
             source: names the table in errors.
             bounds: the prior box by input (native units; the study config's `inputs`), or None for the
@@ -93,12 +96,13 @@ class Problem:
         if bounds is not None:
             lower, upper = prior_box(names, bounds, lower, upper, f"calibration of {'+'.join(shots)}", units or {})
         y = observed_vector(observed_table, shots, emulator.feature_names, source)
+        readout = readout_vector(observed_table, shots, emulator.feature_names, source)
 
         def predict(theta):
             return emulator.predict(dict(zip(names, theta.T)), list(shots))
 
-        return cls(predict, y, sd_fraction * np.abs(y), names, np.asarray(lower), np.asarray(upper), "+".join(shots),
-                   emulator.error_groups(shots))
+        return cls(predict, y, np.hypot(sd_fraction * np.abs(y), readout), names, np.asarray(lower), np.asarray(upper),
+                   "+".join(shots), emulator.error_groups(shots))
 
     @property
     def ndim(self) -> int:
@@ -200,6 +204,23 @@ def observed_vector(table: pd.DataFrame, shots, feature_names, source: str) -> n
             raise InputError(f"{source}: shot {shot}: observed feature(s) {bad} missing or not positive")
         values.append(row)
     return np.concatenate(values)
+
+
+def readout_vector(table: pd.DataFrame, shots, feature_names, source: str) -> np.ndarray:
+    """The read-out sds (m/s) of `shots`' features, shot-major, from the table's `readout_sd_<feature>`
+    columns (0 for a feature without one: a published or hand-made table); a negative or non-numeric
+    value is an error naming the shot and the column."""
+    names = table["shot"].astype(str).str.strip()
+    values = []
+    for shot in shots:
+        row = table[names == shot].iloc[0]
+        for feature in feature_names:
+            column = f"readout_sd_{feature}"
+            value = pd.to_numeric(row.get(column, 0.0), errors="coerce")
+            if not np.isfinite(value) or value < 0:
+                raise InputError(f"{source}: shot {shot}: {column} = {row.get(column)!r} is not a sd (m/s, >= 0)")
+            values.append(float(value))
+    return np.array(values)
 
 
 def log_density(log_likelihood, lambda_y):

@@ -7,7 +7,7 @@ import logging
 from shockcal.cli import add_config_argument
 
 log = logging.getLogger("shockcal.features")
-UNITS = {"t_*": "us", "v_*": "m/s"}
+UNITS = {"t_*": "us", "v_*": "m/s", "readout_sd_v_*": "m/s", "noise_sd_m_s": "m/s", "readout_half_window_ns": "ns"}
 
 
 def register(subparsers) -> None:

@@ -183,16 +183,20 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
 
 
 def observed_table(config: dict) -> pd.DataFrame:
-    """The measured features of every shot (one row per shot: shot, source, the ten features), from
-    the VISAR records through the extractor (`observed.source: records`) or the published values; a
+    """The measured features of every shot (one row per shot: shot, source, the ten features, each
+    calibration feature's read-out sd `readout_sd_v_*` in m/s and the record's noise model), from the
+    VISAR records through the extractor (`observed.source: records`; the read-out sds from
+    `observed.readout_replicates` noise replicates seeded by the shot's `readout` stream of study.seed
+    when `observed.readout_error`, else 0) or the published values (read-out sds 0, no noise model); a
     plastic plateau that does not fit the shot's impact velocity (`checks.plateau_vs_velocity`) is an
     InputError naming the shot and the record."""
     import pandas as pd
 
-    from shockcal.features import COLUMNS, record_features
+    from shockcal.features import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS, record_features
     from shockcal.plausibility import check_plateau
 
     observed = config["observed"]
+    replicates = observed["readout_replicates"] if observed["readout_error"] else 0
     rows = []
     for shot in config["shots"]:      # the config's validation checked that every shot has its source's entry
         if observed["source"] == "records":
@@ -200,12 +204,14 @@ def observed_table(config: dict) -> pd.DataFrame:
             where = f"record {spec['path']} (observed.records.{shot}.path)"
             rows.append({"shot": shot, "source": f"record {spec['path']} (shockcal extractor)",
                          **record_features(spec["path"], extractor_settings(config, shot), shot,
-                                           spec["time_column"], spec["velocity_column"])})
+                                           spec["time_column"], spec["velocity_column"], replicates,
+                                           stream_seed(config["study"]["seed"], "readout", shot))})
         else:
             where = f"observed.features.{shot}"
             rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
-                         **observed["features"][shot]})
+                         **observed["features"][shot], **dict.fromkeys(READOUT_COLUMNS, 0.0),
+                         "noise_sd_m_s": float("nan"), "noise_ar_order": 0, "readout_half_window_ns": 0.0})
         box = velocity_box_m_s(config, shot)
         if box is not None:        # a record of another shot: its plateau is another impact velocity's
             check_plateau(rows[-1], box, f"shot {shot}: {where}", config["checks"]["plateau_vs_velocity"])
-    return pd.DataFrame(rows)[["shot", "source", *COLUMNS]]
+    return pd.DataFrame(rows)[["shot", "source", *COLUMNS, *READOUT_COLUMNS, *RECORD_NOISE_COLUMNS]]

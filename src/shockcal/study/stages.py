@@ -40,7 +40,8 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the failed-run budget where a shot's features are merged
     "failure_budget": ("simulate.max_failed_fraction", "shots.{shot}.analysis"),
     # the measured features of every shot (from the records or the published values)
-    "observed": ("observed.source", "observed.features", "observed.records", "features", "shots.*.analysis",
+    "observed": ("study.seed", "observed.source", "observed.features", "observed.records", "observed.readout_error",
+                 "observed.readout_replicates", "features", "shots.*.analysis",
                  "checks.observed_units", "checks.plateau_vs_velocity", "inputs", "shots.*.velocity_input"),
     # the emulator fit and its cross-validation
     "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", *_SHOT_MAPPING),
