@@ -5,11 +5,12 @@ end to end is tests/test_workflow.py's."""
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import io
 import math
-import subprocess
-import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -27,6 +28,7 @@ from shockcal.candidates import (
     ranking_table,
     score_candidate,
 )
+from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
 from shockcal.features import CALIBRATION_FEATURES
 from shockcal.hydro import AL5083
@@ -202,8 +204,12 @@ def test_ranking_is_sorted_and_says_which_candidates_cannot_be_told_apart():
 
 # --- the commands -----------------------------------------------------------------------------------------------
 
-def shockcal(*args, cwd=REPO):
-    return subprocess.run([sys.executable, "-m", "shockcal", *map(str, args)], cwd=cwd, capture_output=True, text=True)
+def shockcal(*args):
+    """`shockcal ARGS` in this process (the command line's exit code and its stderr)."""
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr):
+        code = main([str(a) for a in args])
+    return SimpleNamespace(returncode=code, stderr=stderr.getvalue())
 
 
 @pytest.fixture
@@ -212,7 +218,7 @@ def two_candidates(tmp_path, paper_config_readonly):
     fake features in which the hot shot's features move with m ten times more."""
     config = copy.deepcopy(paper_config_readonly)
     config["next_shot"] = {"candidates": {"cold": _candidate(), "hot": _candidate(initial_temperature_K=700)},
-                           "targets": ["A", "m"], "n_draws": 100}
+                           "targets": ["A", "m"], "n_draws": 100, "emulator_error": False}
     text = yaml.safe_load((REPO / "config" / "config.yaml").read_text())
     text["next_shot"] = config["next_shot"]
     path = tmp_path / "config.yaml"
@@ -248,6 +254,37 @@ def test_suggest_shot_writes_the_ranking_of_the_issue(tmp_path, two_candidates):
     shockcal("suggest-shot", "--config", path, "--designs", *(f"{n}={d}" for n, (d, _) in files.items()),
              "--features", *(f"{n}={f}" for n, (_, f) in files.items()), "--out", again)
     assert again.read_bytes() == out.read_bytes()                  # same config and seed, same bytes
+
+
+def test_the_emulators_error_joins_the_noise_and_lowers_the_gain(tmp_path, two_candidates):
+    path, _, files = two_candidates
+    text = yaml.safe_load(path.read_text())
+    text["next_shot"]["emulator_error"] = True
+    path.write_text(yaml.safe_dump(text))
+    pairs = ["--designs", *(f"{n}={d}" for n, (d, _) in files.items()),
+             "--features", *(f"{n}={f}" for n, (_, f) in files.items())]
+    rmse = tmp_path / "cv_rmse.csv"
+    rows = [{"scheme": scheme, "shot": shot, "feature": f, "rmse_m_s": 2.0 if scheme == "kfold" else 9.0}
+            for scheme in ("loo_closed_form", "kfold") for shot in ("104S", "105S") for f in CALIBRATION_FEATURES]
+    pd.DataFrame(rows).to_csv(rmse, index=False)
+    done = shockcal("suggest-shot", "--config", path, *pairs, "--out", tmp_path / "r.csv")
+    assert done.returncode == 2 and "next_shot.emulator_error is true: give the emulator's RMSE table" in done.stderr
+    done = shockcal("suggest-shot", "--config", path, *pairs, "--emulator-rmse", rmse, "--out", tmp_path / "r.csv")
+    assert done.returncode == 0, done.stderr
+    with_model = pd.read_csv(tmp_path / "r.csv").set_index("candidate")
+    text["next_shot"]["emulator_error"] = False
+    path.write_text(yaml.safe_dump(text))
+    shockcal("suggest-shot", "--config", path, *pairs, "--out", tmp_path / "plain.csv")
+    plain = pd.read_csv(tmp_path / "plain.csv").set_index("candidate")
+    for name in ("cold", "hot"):
+        noise = plain.loc[name, "noise_sd_v_elastic"]
+        assert with_model.loc[name, "noise_sd_v_elastic"] == pytest.approx(math.hypot(noise, 2.0), rel=0.02)
+        assert with_model.loc[name, "eig_nats"] < plain.loc[name, "eig_nats"]
+    pd.DataFrame(rows).query("shot == '105S'").to_csv(rmse, index=False)
+    text["next_shot"]["emulator_error"] = True
+    path.write_text(yaml.safe_dump(text))
+    done = shockcal("suggest-shot", "--config", path, *pairs, "--emulator-rmse", rmse, "--out", tmp_path / "x.csv")
+    assert done.returncode == 2 and "no kfold RMSE of shot 104S's v_elastic" in done.stderr
 
 
 def test_missing_posterior_and_missing_features_are_one_line(tmp_path, two_candidates):

@@ -32,6 +32,7 @@ rule suggest_shot:
     input:
         designs=expand(rules.next_shot_design.output[0], shot=CANDIDATES),
         features=expand(rules.features.output[0], run_set="next_shot", shot=CANDIDATES),
+        rmse=rules.emulator.output.rmse if config["next_shot"]["emulator_error"] else [],
     output:
         f"{RESULTS}/next_shot/ranking.csv",
     log:
@@ -44,5 +45,7 @@ rule suggest_shot:
         settings=stage_config(config, "suggest_shot"),
         designs=lambda w, input: " ".join(f"{c}={p}" for c, p in zip(CANDIDATES, input.designs)),
         features=lambda w, input: " ".join(f"{c}={p}" for c, p in zip(CANDIDATES, input.features)),
+        rmse=lambda w, input: f"--emulator-rmse {input.rmse}" if input.rmse else "",
     shell:
-        "shockcal suggest-shot --designs {params.designs} --features {params.features} --out {output} > {log} 2>&1"
+        "shockcal suggest-shot --designs {params.designs} --features {params.features} {params.rmse}"
+        " --out {output} > {log} 2>&1"

@@ -5,7 +5,9 @@ next-shot-design reads the joint posterior's equal-weight draws and writes one c
 for every candidate), after checking that the candidate's waves split (`check_split`); its runs go
 through `shockcal simulate --candidate` and `shockcal features --candidate`.
 suggest-shot reads every candidate's design and features and writes the ranking (CSV): per candidate
-the expected information gain about next_shot.targets, its bootstrap sd, the full-theta bracket,
+the expected information gain about next_shot.targets (noise: observed.sd_fraction of each feature,
+with next_shot.readout_sd_m_s and, with next_shot.emulator_error, the emulator's K-fold RMSE of the
+reference shot's features, in quadrature), its bootstrap sd, the full-theta bracket,
 each target's marginal gain and expected posterior sd, the features' spread against the measurement
 noise. Config keys: next_shot, observed.sd_fraction, study.seed, inputs.
 """
@@ -28,6 +30,8 @@ def register(subparsers) -> None:
     add_config_argument(s)
     s.add_argument("--designs", nargs="+", required=True, help="CANDIDATE=DESIGN pairs (next-shot-design's tables)")
     s.add_argument("--features", nargs="+", required=True, help="CANDIDATE=FEATURES pairs (their runs' features)")
+    s.add_argument("--emulator-rmse", help="the emulator's cross-validation RMSE table (emulator/cv_rmse.csv), "
+                   "needed with next_shot.emulator_error")
     s.add_argument("--out", required=True, help="output ranking CSV (results/next_shot/ranking.csv)")
     s.set_defaults(func=run_suggest)
 
@@ -67,9 +71,27 @@ def run_design(args) -> int:
     return 0
 
 
+def emulator_rmse(table, shot: str, features, source: str):
+    """The emulator's K-fold RMSE (m/s) of `shot`'s `features`, from its cv_rmse table; a missing row is an
+    InputError naming the table."""
+
+    from shockcal.errors import InputError
+    from shockcal.io import require_columns
+
+    require_columns(table, ["scheme", "shot", "feature", "rmse_m_s"], source)
+    rows = table[(table["scheme"] == "kfold") & (table["shot"].astype(str) == shot)].set_index("feature")
+    missing = [f for f in features if f not in rows.index]
+    if missing:
+        raise InputError(f"{source}: no kfold RMSE of shot {shot}'s {', '.join(missing)} (a candidate's reference "
+                         "shot): an emulator of other shots?")
+    return rows.loc[list(features), "rmse_m_s"].to_numpy(dtype=float)
+
+
 def run_suggest(args) -> int:
     import logging
     from pathlib import Path
+
+    import numpy as np
 
     from shockcal.candidates import SLOPE, VELOCITY_FACTOR, check_design, ranking_table, score_candidate
     from shockcal.errors import InputError
@@ -90,14 +112,20 @@ def run_suggest(args) -> int:
                                               f"{unknown} are not candidates of next_shot.candidates"))
     names = input_names(config)
     parameters = [*names, VELOCITY_FACTOR, SLOPE]
-    readout = [section["readout_sd_m_s"].get(f, 0.0) for f in CALIBRATION_FEATURES]
+    readout = np.array([section["readout_sd_m_s"].get(f, 0.0) for f in CALIBRATION_FEATURES])
+    if section["emulator_error"] and not args.emulator_rmse:
+        raise InputError("next_shot.emulator_error is true: give the emulator's RMSE table (--emulator-rmse "
+                         "results/emulator/cv_rmse.csv), or set it to false")
+    rmse = read_table(args.emulator_rmse) if section["emulator_error"] else None
     log = logging.getLogger("shockcal.next_shot")
     rows = []
     for name, spec in section["candidates"].items():
         design = check_design(read_table(designs[name]), names, designs[name])
+        model = (np.zeros(len(CALIBRATION_FEATURES)) if rmse is None else
+                 emulator_rmse(rmse, spec["shot"], CALIBRATION_FEATURES, args.emulator_rmse))
         try:
             score = score_candidate(read_table(features[name]), design, CALIBRATION_FEATURES, parameters,
-                                    section["targets"], config["observed"]["sd_fraction"], readout,
+                                    section["targets"], config["observed"]["sd_fraction"], np.hypot(readout, model),
                                     stream_seed(config["study"]["seed"], "next_shot", "eig", name))
         except InputError as exc:
             raise InputError(f"candidate {name} ({features[name]}): {exc}") from None

@@ -114,6 +114,10 @@ def _normalise_shot_names(config: dict) -> None:
     base_shots = (config.get("design") or {}).get("base_shots")
     if isinstance(base_shots, list):
         config["design"]["base_shots"] = [str(shot) for shot in base_shots]
+    next_shot = config.get("next_shot") or {}
+    for spec in [*(next_shot.get("candidates") or {}).values(), next_shot.get("grid")]:
+        if isinstance(spec, dict) and isinstance(spec.get("shot"), int):     # a candidate's reference shot
+            spec["shot"] = str(spec["shot"])
 
 
 def _schema_message(exc) -> str:
