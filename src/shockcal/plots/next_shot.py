@@ -4,8 +4,8 @@ Input: the ranking table (results/next_shot/ranking.csv; `shockcal.candidates.ra
 per candidate (best at the top) the expected information gain about the targets jointly (eig_nats)
 and about each target alone (eig_<p>_nats), with +- 2 bootstrap sd bars. Right: per candidate and
 calibration feature, the spread of the draws' features (their sd over the posterior draws) over the
-measurement noise sd (1% of the feature, with the read-out sd): where it is below 1 the feature
-cannot tell the draws apart.
+noise sd (1% of the feature, with the read-out sd and the emulator's error when the ranking has
+them): where it is below 1 the feature cannot tell the draws apart.
 """
 
 from __future__ import annotations
@@ -40,15 +40,15 @@ def next_shot_ranking(ranking: pd.DataFrame | None, targets: list[str]):
     gain.axvline(0, color="0.6", lw=0.6)
     gain.set_yticks(y, ranking["candidate"])
     gain.set_xlabel("expected information gain (nats), +- 2 bootstrap sd")
-    gain.legend(fontsize=7, loc="lower right")
+    gain.legend(fontsize=7, loc="best")
     markers = ["o", "s", "^", "D"]
     for j, feature in enumerate(f for f in CALIBRATION_FEATURES if f"feature_sd_{f}" in ranking.columns):
         ratio = ranking[f"feature_sd_{feature}"] / ranking[f"noise_sd_{feature}"]
         spread.plot(ratio, y + 0.3 - 0.2 * j, markers[j % 4], ms=4, label=feature, color=palette[j % len(palette)])
-    spread.axvline(1.0, color=COLORS["measurement"], lw=0.8, ls="--", label="= measurement noise")
+    spread.axvline(1.0, color=COLORS["measurement"], lw=0.8, ls="--", label="= the noise")
     spread.set_xscale("log")
-    spread.set_xlabel("spread of the draws' features / measurement noise sd")
-    spread.legend(fontsize=7, loc="lower right")
+    spread.set_xlabel("spread of the draws' features / noise sd (measurement, read-out, emulator)")
+    spread.legend(fontsize=7, loc="best")
     fig.suptitle(f"Which shot next: {len(ranking)} candidates, {int(ranking['n_draws'].max())} joint-posterior "
                  "draws each through the hydrocode")
     return fig
