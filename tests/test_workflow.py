@@ -138,7 +138,8 @@ def test_next_shot_target_ranks_the_quick_candidates(study):
     ranking = pd.read_csv(results / "next_shot" / "ranking.csv")
     assert set(ranking["candidate"]) == {"104S-3.95x5.965mm-204ms-298K", "104S-3.95x5.965mm-204ms-600K"}
     assert ranking["eig_nats"].is_monotonic_decreasing and list(ranking["rank"]) == [1, 2]
-    assert (ranking["n_draws"] + ranking["n_failed"] == 20).all() and (ranking["eig_nats"] > 0).all()
+    assert (ranking["n_draws"] + ranking["n_failed"] == 20).all() and np.isfinite(ranking["eig_nats"]).all()
+    assert (ranking["eig_sd"] > 0).all() and (ranking["noise_sd_v_elastic"] > 0).all()
     assert {f"expected_sd_{p}" for p in ("A", "B", "C", "n", "m")} <= set(ranking.columns)
     for chunk in (0, 1):          # fanned out per candidate and chunk like any run set
         assert (results / "next_shot" / "simulations" / ranking["candidate"][0] / f"chunk-{chunk}.parquet").is_file()

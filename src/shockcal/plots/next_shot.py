@@ -47,7 +47,7 @@ def next_shot_ranking(ranking: pd.DataFrame | None, targets: list[str]):
         spread.plot(ratio, y + 0.3 - 0.2 * j, markers[j % 4], ms=4, label=feature, color=palette[j % len(palette)])
     spread.axvline(1.0, color=COLORS["measurement"], lw=0.8, ls="--", label="= the noise")
     spread.set_xscale("log")
-    spread.set_xlabel("spread of the draws' features / noise sd (measurement, read-out, emulator)")
+    spread.set_xlabel("features' spread over the draws / noise sd")
     spread.legend(fontsize=7, loc="best")
     fig.suptitle(f"Which shot next: {len(ranking)} candidates, {int(ranking['n_draws'].max())} joint-posterior "
                  "draws each through the hydrocode")
