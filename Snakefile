@@ -1,6 +1,8 @@
 # shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
+import re
+
 from shockcal.study.validate import validate_or_exit
 
 
@@ -17,11 +19,12 @@ validate_or_exit(config, source="config")
 
 RESULTS = config["study"]["results_dir"]
 SHOTS = list(config["shots"])
+CANDIDATES = list(config["next_shot"]["candidates"])  # next-shot candidates: the run set next_shot's "shots"
 ALL_TARGETS = []
 
 
 wildcard_constraints:
-    shot="|".join(SHOTS),
+    shot="|".join(re.escape(name) for name in [*SHOTS, *CANDIDATES]),
     chunk=r"\d+",
 
 
@@ -33,6 +36,7 @@ include: "workflow/rules/emulator.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/predict.smk"
 include: "workflow/rules/sensitivity.smk"
+include: "workflow/rules/next_shot.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/report.smk"
 
@@ -41,3 +45,11 @@ rule all:
     default_target: True
     input:
         ALL_TARGETS,
+
+
+rule next_shot:
+    """Which shot next (issue 38): the candidates' ranking and its figure; `make next-shot`, outside `all`
+    (next_shot.n_draws hydrocode runs per candidate, docs/next_shot.md)."""
+    input:
+        rules.suggest_shot.output,
+        TARGET_FIGURES.get("next_shot", []),

@@ -74,10 +74,13 @@ def test_unquoted_shot_names_become_strings(tmp_path, paper_config):
     paper_config["observed"]["features"] = {}
     paper_config["observed"]["records"] = {104: paper_config["observed"]["records"]["104S"]}
     paper_config["design"]["base_shots"] = [104]
+    paper_config["next_shot"] = {"candidates": {"again": {"shot": 104, "flyer_mm": 3.95, "target_mm": 5.965,
+                                                          "velocity_m_s": 204}}}
     validate_config(paper_config)
     assert list(paper_config["shots"]) == ["104"]
     assert list(paper_config["observed"]["records"]) == ["104"]
     assert paper_config["design"]["base_shots"] == ["104"]
+    assert paper_config["next_shot"]["candidates"]["again"]["shot"] == "104"
 
 
 @pytest.mark.parametrize("source, section", [("records", "records"), ("published", "features")])

@@ -60,13 +60,14 @@ def test_schema_with_descriptions_still_validates_configs():
 
 
 def test_reruns_come_from_the_stage_declarations():
-    assert reruns(("hydro", "cfl")) == "simulate"
+    assert reruns(("hydro", "cfl")) == "simulate; next_shot_simulate"        # the next-shot candidates' runs too
     assert reruns(("simulate", "chunk_size")) == "*none declared*"
     assert reruns(("calibration", "n_live")) == "calibrate"
     assert reruns(("shots", "<shot>", "analysis", "cutoff_after_arrival_us")).startswith(
-        "features (its shot); failure_budget (its shot); observed; figures ")
+        "features (its shot); failure_budget (its shot); observed; next_shot_design; next_shot_simulate; "
+        "next_shot_features; figures ")
     assert "simulate (shots that read it)" in reruns(("inputs", "<input>", "min"))
-    assert reruns(("observed", "sd_fraction")) == "calibrate; calibrate_check; figures 9, 10"
+    assert reruns(("observed", "sd_fraction")) == "calibrate; calibrate_check; suggest_shot; figures 9, 10"
     assert reruns(("figures", "dpi")) == "figures"
     # a toy declaration: prefixes either way, wildcards, the job's shot
     stages = {"a": ("x.y",), "b": ("x",), "c": ("x.{shot}.z",), "d": ("w",)}

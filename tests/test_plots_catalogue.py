@@ -29,7 +29,8 @@ def jc_config(paper_config_readonly):
 
 def test_fifteen_figures_in_the_papers_order(paper_config):
     names = list(catalogue(paper_config))
-    assert len(names) == 16 and names[15] == "sobol_indices"          # the paper's fifteen, then the study's own
+    assert len(names) == 17 and names[15] == "sobol_indices"          # the paper's fifteen, then the study's own
+    assert names[16] == "next_shot" and catalogue(paper_config)["next_shot"].target == "next_shot"   # not in `all`
     assert [int(name[3:5]) for name in names[:15]] == list(range(1, 16))
     assert history_names(paper_config) == {"fig11_history_104S": "104S", "fig12_history_105S": "105S",
                                            "fig13_history_106S": "106S"}
@@ -59,6 +60,28 @@ def test_needs_name_known_kinds_and_follow_the_configured_records(paper_config):
     assert specs["fig04_trace_features"].needs == ("sample_simulations:104S",)
     assert "record:104S" not in specs["fig02_records"].needs + specs["fig11_history_104S"].needs
     assert "record:105S" in specs["fig12_history_105S"].needs
+
+
+def test_next_shot_figure_draws_the_ranking(paper_config, tmp_path):
+    import pandas as pd
+
+    assert any("no ranking" in t.get_text() for ax in build_figure("next_shot", FigureInputs(), paper_config).axes
+               for t in ax.texts)
+    rows = []
+    for i, name in enumerate(["104S-repeat", "hot-700K", "105S-repeat"]):
+        row = {"candidate": name, "eig_nats": 2.0 - 0.5 * i, "eig_sd": 0.1, "n_draws": 200}
+        row.update({f"eig_{t}_{k}": v for t in ("A", "B", "C", "n", "m") for k, v in (("nats", 0.5 + 0.1 * i), ("sd", 0.05))})
+        row.update({f"{k}_{f}": v for f in ("v_elastic", "v_plastic", "v_slope1", "v_slope2")
+                    for k, v in (("feature_sd", 3.0 + i), ("noise_sd", 1.0))})
+        rows.append(row)
+    path = tmp_path / "ranking.csv"
+    pd.DataFrame(rows).to_csv(path, index=False)
+    fig = build_figure("next_shot", FigureInputs({"next_shot_ranking": [str(path)]}), paper_config)
+    gain = fig.axes[0]
+    top_down = sorted(zip(gain.get_yticks(), (t.get_text() for t in gain.get_yticklabels())), reverse=True)
+    assert [label for _, label in top_down] == ["104S-repeat", "hot-700K", "105S-repeat"]     # best on top
+    (png,) = save_figure(fig, tmp_path / "next_shot", ["png"], dpi=60)
+    assert imread(png).shape[0] > 100
 
 
 def test_unknown_figure_is_named(paper_config):

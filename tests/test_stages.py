@@ -20,9 +20,16 @@ def needs_shot(stage: str) -> bool:
     return any("{shot" in path for path in STAGE_KEYS[stage])
 
 
+def subjects(config, stage: str) -> list:
+    """What a stage's `{shot}` names: a shot, or for the next-shot stages a candidate (None: no shot)."""
+    if not needs_shot(stage):
+        return [None]
+    return list(config["next_shot"]["candidates"] if stage.startswith("next_shot") else config["shots"])
+
+
 def test_every_declared_key_exists_in_the_default_study(config):
     for stage in STAGE_KEYS:
-        for shot in config["shots"] if needs_shot(stage) else [None]:
+        for shot in subjects(config, stage):
             assert stage_config(config, stage, shot), stage
     for name in catalogue(config):
         assert "figures" in figure_config(config, name)
@@ -39,7 +46,7 @@ def test_a_shot_stage_sees_its_own_shot_and_inputs_only(config):
 
 def test_a_sampler_setting_is_outside_every_stage_but_the_calibration(config):
     readers = {stage for stage in STAGE_KEYS
-               if "n_live" in stage_config(config, stage, "104S" if needs_shot(stage) else None).get("calibration", {})}
+               if "n_live" in stage_config(config, stage, subjects(config, stage)[0]).get("calibration", {})}
     assert readers == {"calibrate"}
 
 

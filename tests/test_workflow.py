@@ -79,7 +79,7 @@ def study(tmp_path_factory):
 def test_every_figure_is_a_real_image(study):
     results, _ = study
     config = load_config(REPO / "config" / "config.yaml")
-    names = list(catalogue(config))
+    names = [name for name, spec in catalogue(config).items() if spec.target == "all"]
     assert len(names) == 16                                   # the paper's fifteen and the Sobol indices
     for name in names:
         png, pdf = results / "figures" / f"{name}.png", results / "figures" / f"{name}.pdf"
@@ -126,6 +126,25 @@ def test_netcdf_and_sobol_products(study):
     sobol = pd.read_csv(results / "sensitivity" / "sobol.csv")
     assert list(sobol.columns) == ["domain", "shot", "feature", "input", "S1", "S1_conf", "ST", "ST_conf"]
     assert set(sobol["domain"]) == {"prior", "posterior_q05_q95"} and sobol["ST"].between(-0.1, 1.2).all()
+
+
+@pytest.mark.slow   # 40-60 s on 2 cores (4 simulate and 4 feature jobs, 33 CPU s in all); tests/test_candidates.py is the fast check
+def test_next_shot_target_ranks_the_quick_candidates(study):
+    """`snakemake next_shot` on the quick study: two candidates (104S's plates at 298 and 600 K), 20 joint-posterior
+    draws each through the hydrocode as the run set next_shot, ranked into next_shot/ranking.csv with its figure;
+    `all` is left untouched."""
+    results, config = study
+    snakemake("next_shot", "--cores", "2", config_files=[config])
+    ranking = pd.read_csv(results / "next_shot" / "ranking.csv")
+    assert set(ranking["candidate"]) == {"104S-3.95x5.965mm-204ms-298K", "104S-3.95x5.965mm-204ms-600K"}
+    assert ranking["eig_nats"].is_monotonic_decreasing and list(ranking["rank"]) == [1, 2]
+    assert (ranking["n_draws"] + ranking["n_failed"] == 20).all() and np.isfinite(ranking["eig_nats"]).all()
+    assert (ranking["eig_sd"] > 0).all() and (ranking["noise_sd_v_elastic"] > 0).all()
+    assert {f"expected_sd_{p}" for p in ("A", "B", "C", "n", "m")} <= set(ranking.columns)
+    for chunk in (0, 1):          # fanned out per candidate and chunk like any run set
+        assert (results / "next_shot" / "simulations" / ranking["candidate"][0] / f"chunk-{chunk}.parquet").is_file()
+    assert matplotlib.image.imread(results / "figures" / "next_shot.png").shape[0] > 300
+    assert pending_jobs(config) == {} and pending_jobs(config, target="next_shot") == {}
 
 
 def test_nothing_to_redo(study):

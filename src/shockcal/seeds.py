@@ -18,6 +18,7 @@ keyed further (an emulator block index, a calibration's shots).
 | design_extension | the column of an input only a later shot reads (`design.base_shots`), keyed by shot and input |
 | sensitivity | the Sobol sequence's scrambling and the bootstrap of the Sobol indices |
 | readout | the noise replicates of a measured record's read-out bootstrap (`shockcal observed`), keyed by shot |
+| next_shot | the draws run at every next-shot candidate (key "draws"); each candidate's information gain ("eig", name) |
 """
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ import zlib
 import numpy as np
 
 STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
-           "sensitivity", "readout")
+           "sensitivity", "readout", "next_shot")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

@@ -38,10 +38,27 @@ def run_set_path(run_set, *parts):
 
 
 def run_set_design(wildcards):
-    """The design a run set's chunks read: the training design is planned at parse time (ancient)."""
+    """The design a run set's chunks read: the training design is planned at parse time (ancient); a
+    next-shot candidate has its own (next_shot.smk)."""
     if wildcards.run_set == "training":
         return ancient(DESIGN)
+    if wildcards.run_set == "next_shot":
+        return run_set_path("next_shot", "designs", f"{wildcards.shot}.parquet")
     return run_set_path(wildcards.run_set, "design.parquet")
+
+
+# a shot's stage -> the same stage for a next-shot candidate (the run set next_shot, whose "shots" are candidates;
+# `shockcal simulate/features --shot` take a candidate's name too)
+CANDIDATE_STAGES = {
+    "simulate": "next_shot_simulate",
+    "features": "next_shot_features",
+    "failure_budget": "next_shot_features",
+}
+
+
+def run_set_settings(stage):
+    """The rule param of `stage`'s config slice for the job's shot, or its candidate's in the run set next_shot."""
+    return lambda w: stage_config(config, CANDIDATE_STAGES[stage] if w.run_set == "next_shot" else stage, w.shot)
 
 
 def simulations(run_set, shot):

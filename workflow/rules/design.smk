@@ -11,7 +11,9 @@
 #   training: the design below, for the emulator;
 #   predict:  predict.n_posterior_runs seeded joint-posterior draws (Figs 10-13; predict.smk);
 #   check:    calibration.check.trials truths on a Latin hypercube over the box, for the synthetic-truth
-#             check with hydrocode-made pseudo-measurements (calibrate.smk).
+#             check with hydrocode-made pseudo-measurements (calibrate.smk);
+#   next_shot: next_shot.n_draws joint-posterior draws at each next-shot candidate, whose names take the
+#             shots' place ({RESULTS}/next_shot/simulations/<candidate>/; next_shot.smk).
 
 
 DESIGN = run_set_path("training", "design.parquet")
@@ -27,5 +29,6 @@ RUN_SET_SIZES = {
     "training": len(_PLANNED_DESIGN),
     "predict": config["predict"]["n_posterior_runs"],
     "check": config["calibration"]["check"]["trials"],
+    "next_shot": config["next_shot"]["n_draws"],
 }
 RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SET_SIZES.items()}

@@ -16,7 +16,7 @@ rule features_chunk:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=lambda w: stage_config(config, "features", w.shot),
+        settings=run_set_settings("features"),
     shell:
         "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget --out {output} > {log} 2>&1"
 
@@ -37,7 +37,7 @@ rule features:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=lambda w: stage_config(config, "failure_budget", w.shot),
+        settings=run_set_settings("failure_budget"),
     shell:
         "shockcal features --shot {wildcards.shot} --tables {input} --out {output} > {log} 2>&1"
 

@@ -24,6 +24,7 @@ INPUT_FILES = {
     "predicted_features": lambda shot: expand(rules.features.output[0], run_set="predict", shot=shot),
     "posterior": lambda name: [rules.calibrate.output.samples.format(name=name)],
     "sobol": lambda _: [rules.sensitivity.output[0]],
+    "next_shot_ranking": lambda _: [rules.suggest_shot.output[0]],
 }
 assert set(INPUT_FILES) == set(INPUT_KINDS), "figures.smk: INPUT_FILES must cover the catalogue's INPUT_KINDS"
 FIGURE_INPUTS = {
@@ -63,4 +64,14 @@ for _name, _spec in FIGURE_SPECS.items():
             "shockcal figures --figure {params.figure} --out-dir {params.out_dir}" " {params.inputs} > {log} 2>&1"
 
 
-ALL_TARGETS.extend(f"{RESULTS}/figures/{name}.{fmt}" for name in FIGURE_SPECS for fmt in FIGURE_FORMATS)
+ALL_TARGETS.extend(
+    f"{RESULTS}/figures/{name}.{fmt}"
+    for name, spec in FIGURE_SPECS.items()
+    if spec.target == "all"
+    for fmt in FIGURE_FORMATS
+)
+# the figures of other targets (next_shot), by target
+TARGET_FIGURES = {}
+for _name, _spec in FIGURE_SPECS.items():
+    if _spec.target != "all":
+        TARGET_FIGURES.setdefault(_spec.target, []).extend(f"{RESULTS}/figures/{_name}.{fmt}" for fmt in FIGURE_FORMATS)

@@ -20,7 +20,7 @@ rule simulate:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=lambda w: stage_config(config, "simulate", w.shot),
+        settings=run_set_settings("simulate"),
         rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
         rows_digest=lambda w: CHUNK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "training" else "",
         end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",

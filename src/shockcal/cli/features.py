@@ -13,7 +13,8 @@ UNITS = {"t_*": "us", "v_*": "m/s", "readout_sd_v_*": "m/s", "noise_sd_m_s": "m/
 def register(subparsers) -> None:
     p = subparsers.add_parser("features", help="extract the features of simulated traces or of a measured record")
     add_config_argument(p)
-    p.add_argument("--shot", required=True, help="shot name (its analysis window is in the config)")
+    p.add_argument("--shot", required=True, help="shot name (its analysis window is in the config), or a next-shot "
+                   "candidate's (its window derived from its reference shot's; no failed-run budget)")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--traces", nargs="+", help="simulation tables (Parquet or CSV) from `shockcal simulate`")
     source.add_argument("--record", help="a measured record (time us, velocity m/s)")
@@ -37,14 +38,19 @@ def run(args) -> int:
 
     from shockcal.features import check_failures, record_features
     from shockcal.io import write_table
-    from shockcal.study.adapters import extractor_settings
-    from shockcal.study.stages import load_stage_config
+    from shockcal.study.adapters import candidate_extractor_settings, extractor_settings
+    from shockcal.study.config import candidate_config
+    from shockcal.study.stages import is_candidate, load_stage_config
 
-    config = load_stage_config(args.config, feature_stages(args), args.shot)
+    name = args.shot
+    candidate = is_candidate(args.config, name)
+    config = load_stage_config(args.config, feature_stages(args, candidate), name)
+    analysis = (candidate_config(config, name) if candidate else config["shots"][name])["analysis"]
+    settings = None if args.tables else (candidate_extractor_settings if candidate else extractor_settings)(config, name)
     if args.record:
         table = pd.DataFrame([{"run": 0, "status": "ok", "reason": "",
-                               **record_features(args.record, extractor_settings(config, args.shot),
-                                                 args.shot, args.time_column, args.velocity_column)}])
+                               **record_features(args.record, settings, name, args.time_column,
+                                                 args.velocity_column)}])
     else:
         from shockcal.features import features_table
         from shockcal.io import read_tables
@@ -53,16 +59,18 @@ def run(args) -> int:
             table = read_tables(args.tables, ["run"], "features")
         else:
             traces = read_tables(args.traces, ["run"], "simulations")
-            table = features_table(traces, extractor_settings(config, args.shot), ", ".join(args.traces))
-        if not args.no_failure_budget:
-            check_failures(table, config["simulate"]["max_failed_fraction"], args.shot)
-    write_table(table, args.out, {"table": "features", "shot": args.shot, "units": UNITS,
-                                  "analysis": config["shots"][args.shot]["analysis"]})
+            table = features_table(traces, settings, ", ".join(args.traces))
+        if not args.no_failure_budget and not candidate:
+            check_failures(table, config["simulate"]["max_failed_fraction"], name)
+    write_table(table, args.out, {"table": "features", "shot": name, "units": UNITS, "analysis": analysis})
     return 0
 
 
-def feature_stages(args) -> list[str]:
-    """The stages (shockcal.study.stages) a `features` call is: extraction, the failed-run budget, or both."""
+def feature_stages(args, candidate: bool = False) -> list[str]:
+    """The stages (shockcal.study.stages) a `features` call is: extraction, the failed-run budget, or both;
+    a next-shot candidate's: its window (its failed runs are counted by suggest-shot, not budgeted)."""
+    if candidate:
+        return ["next_shot_features"]
     extracts = not args.tables
     budget = not args.record and not args.no_failure_budget
     return [stage for stage, used in (("features", extracts), ("failure_budget", budget)) if used]

@@ -39,6 +39,7 @@ INPUT_KINDS = {
     "predicted_features": "the features of a shot's runs at posterior draws",
     "posterior": "a calibration's posterior draws (a shot or 'joint')",
     "sobol": "the emulator's Sobol indices (sensitivity/sobol.csv)",
+    "next_shot_ranking": "the next-shot candidates' ranking (next_shot/ranking.csv)",
 }
 
 
@@ -86,6 +87,7 @@ class FigureSpec:
     build: Callable  # (FigureInputs, config) -> matplotlib Figure
     reads: tuple[str, ...] = ()  # config keys `build` reads besides `figures` (shockcal.study.stages paths)
     needs: tuple[str, ...] = ()  # FigureInputs keys `build` reads, for the config's shots (kinds: INPUT_KINDS)
+    target: str = "all"  # the workflow target that makes it (`all`, or `next_shot`: outside the study)
 
 
 def _shots(config) -> list[str]:
@@ -169,6 +171,12 @@ def _sobol(inputs, config):
     return sobol_indices(inputs.table("sobol"), _shots(config))
 
 
+def _next_shot(inputs, config):
+    from shockcal.plots.next_shot import next_shot_ranking
+
+    return next_shot_ranking(inputs.table("next_shot_ranking"), list(config["next_shot"]["targets"]))
+
+
 def history_names(config) -> dict[str, str]:
     """{figure name: shot} for Figs 11-13 (the first three shots of the config)."""
     return {f"fig{11 + i}_history_{shot}": shot for i, shot in enumerate(_shots(config)[:3])}
@@ -220,6 +228,9 @@ def catalogue(config) -> dict[str, FigureSpec]:
                    trace),
         # beyond the paper
         FigureSpec("sobol_indices", "6 sensitivity", _sobol, ("shots",), ("sobol",)),
+        # which shot next (`make next-shot`), when the config has candidates
+        *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets",), ("next_shot_ranking",),
+                      "next_shot")] if config.get("next_shot", {}).get("candidates") else []),
     ]
     return {spec.name: spec for spec in specs}
 

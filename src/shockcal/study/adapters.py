@@ -16,13 +16,14 @@ from shockcal.design import InputBox, ShotMapping, extend_design, latin_hypercub
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
 from shockcal.seeds import stream_seed
-from shockcal.study.config import end_time_us, prior_bounds, shot_config, velocity_box_m_s
+from shockcal.study.config import candidate_config, end_time_us, prior_bounds, shot_config, velocity_box_m_s
 from shockcal.study.strength import DEFAULT_MODEL, strength_model
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from shockcal.calibration import CalibrationSettings
+    from shockcal.candidates import Candidate
     from shockcal.emulator import EmulatorSpec
     from shockcal.features import ExtractorSettings
     from shockcal.pcgp import Settings as EmulatorSettings
@@ -78,6 +79,46 @@ def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
     from shockcal.features import ExtractorSettings
 
     return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
+
+
+def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
+    """A next-shot candidate's analysis window (`candidate_config`) and `features`."""
+    from shockcal.features import ExtractorSettings
+
+    return ExtractorSettings(**candidate_config(config, name)["analysis"], **config["features"])
+
+
+def candidate(config: dict, name: str) -> Candidate:
+    """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs."""
+    from shockcal.candidates import Candidate
+
+    spec = candidate_config(config, name)
+    temperature = spec["initial_temperature_K"]
+    return Candidate(name, float(spec["flyer_mm"]), float(spec["target_mm"]), float(spec["velocity_m_s"]),
+                     None if temperature is None else float(temperature), tuple(spec["shear_modulus_inputs"]))
+
+
+def candidate_box(config: dict, name: str) -> InputBox:
+    """The box a candidate's design lies in: the prior box of the Johnson-Cook inputs, and the
+    candidate's velocity (cm/us, within the velocity error's range) and shear modulus (Mbar, the
+    reference shot's box scaled by the thermal slopes' range)."""
+    from shockcal.candidates import SHEAR_MODULUS, VELOCITY
+    from shockcal.hydro import JOHNSON_COOK_INPUTS
+    from shockcal.study.config import shear_modulus_box_Mbar
+    from shockcal.units import CM_US_TO_M_S
+
+    shot = candidate(config, name)
+    section = config["next_shot"]
+    spread = 3.0**0.5 * section["velocity_sd_fraction"]
+    velocity = shot.velocity_m_s / CM_US_TO_M_S
+    heating = 0.0 if shot.initial_temperature_K is None else shot.initial_temperature_K - config["material"]["T_ref_K"]
+    factors = [1.0 + section["shear_modulus_log_slope_per_K"][end] * heating for end in ("min", "max")]
+    g_box = shear_modulus_box_Mbar(config, config["next_shot"]["candidates"][name]["shot"]) or (0.0, float("inf"))
+    bounds = {**{k: v for k, v in prior_bounds(config).items() if k in JOHNSON_COOK_INPUTS},
+              VELOCITY: (velocity * (1 - spread), velocity * (1 + spread)),
+              SHEAR_MODULUS: (g_box[0] * min(factors), g_box[1] * max(factors))}
+    units = {**{k: config["inputs"][k]["unit"] for k in JOHNSON_COOK_INPUTS}, VELOCITY: "cm/us", SHEAR_MODULUS: "Mbar"}
+    return InputBox(bounds, units, {VELOCITY: name}, config["checks"]["design_box"])
 
 
 def emulator_settings(config: dict) -> EmulatorSettings:

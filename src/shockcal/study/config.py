@@ -49,3 +49,54 @@ def velocity_box_m_s(config: dict, shot: str) -> tuple[float, float] | None:
     box = config["inputs"][shot_config(config, shot)["velocity_input"]]
     factor = VELOCITY_TO_M_S.get(str(box["unit"]).strip())
     return None if factor is None else (box["min"] * factor, box["max"] * factor)
+
+
+SHEAR_MODULUS_TO_MBAR = {"Mbar": 1.0, "GPa": 0.01, "kbar": 1e-3}
+
+
+def shear_modulus_box_Mbar(config: dict, shot: str) -> tuple[float, float] | None:
+    """The smallest and largest shear modulus of `shot`'s prior box (Mbar, the sum of its
+    `shear_modulus_inputs`' bounds), or None when one of them is in a unit not in SHEAR_MODULUS_TO_MBAR."""
+    spec = shot_config(config, shot)
+    units = [str(config["inputs"][name]["unit"]).strip() for name in spec["shear_modulus_inputs"]]
+    if any(unit not in SHEAR_MODULUS_TO_MBAR for unit in units):
+        return None
+    return tuple(sum(config["inputs"][name][end] * SHEAR_MODULUS_TO_MBAR[unit]
+                     for name, unit in zip(spec["shear_modulus_inputs"], units)) for end in ("min", "max"))
+
+
+def plateau_us(config: dict, flyer_mm: float, target_mm: float, shear_modulus_Mbar: float) -> float:
+    """Time from the first arrival to the release's arrival at the free surface (us) of a symmetric
+    impact of the config's material (`shockcal.plausibility.release_times_us`)."""
+    from shockcal.plausibility import release_times_us
+
+    material = config["material"]
+    arrival, release = release_times_us(flyer_mm, target_mm, material["rho0_g_cc"], material["eos"]["c1_Mbar"],
+                                        shear_modulus_Mbar)
+    return release - arrival
+
+
+def candidate_config(config: dict, name: str) -> dict:
+    """A next-shot candidate (`next_shot.candidates.<name>`) as a shot section: flyer_mm, target_mm,
+    initial_temperature_K, velocity_m_s, its reference `shot`, that shot's `shear_modulus_inputs`, and
+    `analysis`: the reference shot's cut-off, and its window unless the candidate gives one, scaled
+    by the ratio of the two plateaus (`plateau_us` at the reference shot's largest shear modulus, the
+    earliest release): the same share of the plateau as the reference shot's window. An unknown
+    candidate is a ConfigError listing the known ones."""
+    candidates = config["next_shot"]["candidates"]
+    if name not in candidates:
+        raise ConfigError(f"unknown next-shot candidate '{name}'; the config defines {sorted(candidates)}")
+    spec = candidates[name]
+    reference = shot_config(config, spec["shot"])
+    analysis = dict(reference["analysis"])
+    if spec.get("window_after_arrival_us") is not None:
+        analysis["window_after_arrival_us"] = float(spec["window_after_arrival_us"])
+    else:
+        box = shear_modulus_box_Mbar(config, spec["shot"])
+        if box is not None:
+            share = (plateau_us(config, spec["flyer_mm"], spec["target_mm"], box[1])
+                     / plateau_us(config, reference["flyer_mm"], reference["target_mm"], box[1]))
+            analysis["window_after_arrival_us"] = analysis["window_after_arrival_us"] * share
+    return {"flyer_mm": spec["flyer_mm"], "target_mm": spec["target_mm"], "velocity_m_s": spec["velocity_m_s"],
+            "initial_temperature_K": spec.get("initial_temperature_K"), "shot": spec["shot"],
+            "shear_modulus_inputs": list(reference["shear_modulus_inputs"]), "analysis": analysis}

@@ -20,9 +20,10 @@ DOC_PATH = Path("docs") / "configuration.md"   # relative to the repository root
 
 # how a key of a free-form mapping (`additionalProperties`) is written in a key path
 PLACEHOLDERS = {"shots": "<shot>", "inputs": "<input>", "observed.features": "<shot>", "observed.records": "<shot>",
-                "calibration.cube_power": "<input>", "strength.inputs": "<parameter>"}
+                "calibration.cube_power": "<input>", "strength.inputs": "<parameter>",
+                "next_shot.candidates": "<candidate>", "next_shot.readout_sd_m_s": "<feature>"}
 # unit suffixes of key names (shockcal's "units in names"), longest match first
-UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_g_cc", "g/cc"), ("_Mbar", "Mbar"), ("_mm", "mm"),
+UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K"), ("_g_cc", "g/cc"), ("_Mbar", "Mbar"), ("_mm", "mm"),
                  ("_um", "um"), ("_us", "us"), ("_ns", "ns"), ("_K", "K"))
 # STAGE_KEYS path segments that stand for any key, and what they say about which jobs rerun
 WILDCARDS = {"*": "", "{shot}": "its shot", "{shot_inputs}": "shots that read it"}

@@ -26,6 +26,11 @@ from shockcal.study.validate import load_config
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "strength.model?")
 
+# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window)
+_CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
+              "shots.*.analysis", "inputs", "material")
+_CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
+
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
     "design": ("study.seed", "design", "inputs", "checks.design_box", *_SHOT_MAPPING),
@@ -59,6 +64,13 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
     "sensitivity": ("study.seed", "sensitivity", "inputs"),
+    # a next-shot candidate's design: the joint posterior's draws with the new shot's nuisance inputs
+    "next_shot_design": ("study.seed", "next_shot.n_draws", *_CANDIDATE_BOX, *_CANDIDATE),
+    # a candidate's hydrocode runs and their features
+    "next_shot_simulate": ("hydro", *_CANDIDATE_BOX, *_CANDIDATE),
+    "next_shot_features": ("features", *_CANDIDATE),
+    # the candidates' information gains and their ranking
+    "suggest_shot": ("study.seed", "next_shot", "observed.sd_fraction", "inputs", "material.T_ref_K"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
     "figures": ("figures",),
 }
@@ -98,9 +110,16 @@ def load_stage_config(path, stages: str | Iterable[str], shot: str | None = None
     """Read and validate the whole study config at `path` (every key is checked), then return the
     slice `stages` read; with `shot`, an unknown shot is a ConfigError naming the known ones."""
     config = load_config(path)
-    if shot is not None:
+    if shot is not None and shot not in config["next_shot"]["candidates"]:
         shot_config(config, shot)
     return stage_config(config, stages, shot)
+
+
+def is_candidate(path, name: str) -> bool:
+    """Whether `name` is a next-shot candidate of the study config at `path` (and not a shot): the
+    `--shot` of `shockcal simulate` and `features` names either."""
+    config = load_config(path)
+    return name not in config["shots"] and name in config["next_shot"]["candidates"]
 
 
 def _expand(config: dict, parts: list[str], shot: str | None, stage: str) -> Iterator[list[str]]:

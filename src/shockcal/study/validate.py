@@ -17,8 +17,9 @@ from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import load_study_design
-from shockcal.study.config import velocity_box_m_s
+from shockcal.study.config import SHEAR_MODULUS_TO_MBAR, candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
 from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, strength_model
+from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
@@ -70,6 +71,7 @@ def validate_config(config: dict, source: str = "config") -> dict:
     except ValidationError as exc:
         raise ConfigError(f"{source}: {_schema_message(exc)}") from None
     apply_strength_model(config, source)
+    expand_candidate_grid(config, source)
     check_semantics(config, source)
     check_design_file(config, source)
     return config
@@ -114,6 +116,10 @@ def _normalise_shot_names(config: dict) -> None:
     base_shots = (config.get("design") or {}).get("base_shots")
     if isinstance(base_shots, list):
         config["design"]["base_shots"] = [str(shot) for shot in base_shots]
+    next_shot = config.get("next_shot") or {}
+    for spec in [*(next_shot.get("candidates") or {}).values(), next_shot.get("grid")]:
+        if isinstance(spec, dict) and isinstance(spec.get("shot"), int):     # a candidate's reference shot
+            spec["shot"] = str(spec["shot"])
 
 
 def _schema_message(exc) -> str:
@@ -170,6 +176,7 @@ def check_semantics(config: dict, source: str = "config") -> None:
             raise ConfigError(f"{source}: observed.records.{shot}.path: {record['path']} does not exist")
     for shot in config["shots"]:
         check_window(config, shot, source)
+    check_next_shot(config, source)
     source_section = "records" if observed["source"] == "records" else "features"
     for shot in config["shots"]:
         if shot not in observed[source_section]:
@@ -183,6 +190,79 @@ def _law_has_modulus(config: dict) -> bool:
     from shockcal.hydro.laws import get_law
 
     return get_law(strength_model(config)).shear_modulus is not None
+
+
+# the plastic rise needs this long inside the window after the plastic wave arrives (the paper's shots rise
+# from 10% to 90% of it, t_slope1 to t_slope2, in 0.06-0.16 us)
+PLASTIC_RISE_US = 0.2
+
+
+def expand_candidate_grid(config: dict, source: str = "config") -> None:
+    """`next_shot.grid` added to `next_shot.candidates`, one named candidate per combination (null
+    candidates read as none); a grid name that is already another candidate is a ConfigError."""
+    section = config.get("next_shot") or {}
+    if section.get("candidates", {}) is None:
+        section["candidates"] = {}
+    grid = section.get("grid")
+    if not grid:
+        return
+    import itertools
+
+    for flyer, target, velocity, temperature in itertools.product(grid["flyer_mm"], grid["target_mm"],
+                                                                  grid["velocity_m_s"], grid["initial_temperature_K"]):
+        name = f"{grid['shot']}-{flyer:g}x{target:g}mm-{velocity:g}ms-{temperature:g}K"
+        spec = {"shot": grid["shot"], "flyer_mm": flyer, "target_mm": target, "velocity_m_s": velocity,
+                "initial_temperature_K": temperature}
+        if section["candidates"].get(name, spec) != spec:   # the same entry: a config validated before
+            raise ConfigError(f"{source}: next_shot.grid: candidate {name} is also in next_shot.candidates")
+        section["candidates"][name] = spec
+
+
+def check_next_shot(config: dict, source: str = "config") -> None:
+    """The next-shot section: targets among the inputs, each candidate's reference shot known, its name
+    not a shot's, its initial temperature below melting, its window clear of the release (plates too
+    thin for it) and long enough for the plastic wave to arrive and rise (`PLASTIC_RISE_US`). The split
+    of the elastic and plastic waves needs the posterior (`shockcal.candidates.check_split`)."""
+    section, inputs = config["next_shot"], config["inputs"]
+    for target in section["targets"]:
+        if target not in inputs:
+            raise ConfigError(f"{source}: next_shot.targets: unknown target '{target}'; the inputs are {sorted(inputs)}")
+    if len(set(section["targets"])) != len(section["targets"]):
+        raise ConfigError(f"{source}: next_shot.targets: {section['targets']} names a target twice")
+    slope = section["shear_modulus_log_slope_per_K"]
+    if slope["min"] > slope["max"]:
+        raise ConfigError(f"{source}: next_shot.shear_modulus_log_slope_per_K: min ({slope['min']:g}) is above max "
+                          f"({slope['max']:g})")
+    if section["readout_sd_m_s"]:
+        from shockcal.features import CALIBRATION_FEATURES
+
+        for feature in section["readout_sd_m_s"]:
+            if feature not in CALIBRATION_FEATURES:
+                raise ConfigError(f"{source}: next_shot.readout_sd_m_s.{feature}: not a calibration feature "
+                                  f"{list(CALIBRATION_FEATURES)}")
+    for name, spec in section["candidates"].items():
+        where = f"{source}: next_shot.candidates.{name}"
+        if name in config["shots"]:
+            raise ConfigError(f"{where}: '{name}' is also a shot's name; give the candidate its own")
+        if spec["shot"] not in config["shots"]:
+            raise ConfigError(f"{where}.shot: '{spec['shot']}' is not a shot; known shots are {sorted(config['shots'])}")
+        check_initial_temperature(spec, config["material"], f"{where}.initial_temperature_K")
+        box = shear_modulus_box_Mbar(config, spec["shot"])
+        if box is None:
+            continue
+        candidate = candidate_config(config, name)
+        check_window_fits(config, candidate, box[1], where)
+        material = config["material"]
+        c_bulk = (material["eos"]["c1_Mbar"] / material["rho0_g_cc"]) ** 0.5
+        c_l = (c_bulk**2 + 4.0 * box[1] / (3.0 * material["rho0_g_cc"])) ** 0.5
+        lag = spec["target_mm"] * MM_TO_CM * (1.0 / c_bulk - 1.0 / c_l)
+        window = candidate["analysis"]["window_after_arrival_us"]
+        if window < lag + PLASTIC_RISE_US:
+            raise ConfigError(
+                f"{where}: the plastic wave reaches the free surface {lag:.3g} us after the elastic precursor (target "
+                f"{spec['target_mm']:g} mm), and the analysis window ({window:.3g} us, ended by the release from the "
+                f"{spec['flyer_mm']:g} mm flyer) leaves under {PLASTIC_RISE_US:g} us for its rise: the plates are too "
+                "thin for a plateau; take a thicker flyer or a thinner target")
 
 
 def check_initial_temperature(spec: dict, material: dict, where: str) -> None:
@@ -213,9 +293,6 @@ def check_distinct(observed: dict, source: str) -> None:
         seen[key] = shot
 
 
-SHEAR_MODULUS_TO_MBAR = {"Mbar": 1.0, "GPa": 0.01, "kbar": 1e-3}
-
-
 def check_window(config: dict, shot: str, source: str) -> None:
     """The analysis window of `shot` must end before the release from the flyer's back reaches the free
     surface (`shockcal.plausibility.release_times_us`, with the config's material and plates, and the
@@ -223,21 +300,29 @@ def check_window(config: dict, shot: str, source: str) -> None:
     read the release as part of the plateau. Shear-modulus inputs in a unit other than
     SHEAR_MODULUS_TO_MBAR's are not checked. A law with its own G law (SG, PTW) uses its G0_GPa box's
     maximum: the rise of G with pressure is left out, so this check is a little lenient for them."""
-    spec, material = config["shots"][shot], config["material"]
-    terms = ["G0_GPa"] if _law_has_modulus(config) else spec["shear_modulus_inputs"]
-    units = [str(config["inputs"][name]["unit"]).strip() for name in terms]
-    if any(unit not in SHEAR_MODULUS_TO_MBAR for unit in units):
-        return
-    g_max = sum(config["inputs"][name]["max"] * SHEAR_MODULUS_TO_MBAR[unit] for name, unit in zip(terms, units))
+    if _law_has_modulus(config):
+        unit = str(config["inputs"]["G0_GPa"]["unit"]).strip()
+        g_max = config["inputs"]["G0_GPa"]["max"] * SHEAR_MODULUS_TO_MBAR[unit] if unit in SHEAR_MODULUS_TO_MBAR else None
+    else:
+        box = shear_modulus_box_Mbar(config, shot)
+        g_max = None if box is None else box[1]
+    if g_max is not None:
+        check_window_fits(config, config["shots"][shot], g_max, f"{source}: shots.{shot}")
+
+
+def check_window_fits(config: dict, spec: dict, g_max_Mbar: float, where: str) -> None:
+    """`check_window` for a shot section `spec` (a shot's or a candidate's, `candidate_config`) and the
+    largest shear modulus `g_max_Mbar`; `where` names its config key."""
+    material = config["material"]
     arrival, release = release_times_us(spec["flyer_mm"], spec["target_mm"], material["rho0_g_cc"],
-                                        material["eos"]["c1_Mbar"], g_max)
+                                        material["eos"]["c1_Mbar"], g_max_Mbar)
     window = spec["analysis"]["window_after_arrival_us"]
     if window >= release - arrival:
         raise ConfigError(
-            f"{source}: shots.{shot}.analysis.window_after_arrival_us: {window:g} us reaches the release from the "
+            f"{where}.analysis.window_after_arrival_us: {window:g} us reaches the release from the "
             f"flyer's back, {release - arrival:.3g} us after the first arrival (first arrival {arrival:.3g} us after "
             f"impact, release {release:.3g} us: flyer {spec['flyer_mm']:g} mm, target {spec['target_mm']:g} mm, "
-            f"the box's largest shear modulus {g_max * 100:.3g} GPa); end the window before it")
+            f"the box's largest shear modulus {g_max_Mbar * 100:.3g} GPa); end the window before it")
 
 
 def check_design_file(config: dict, source: str = "config") -> None:
