@@ -35,6 +35,7 @@ from shockcal.hydro import AL5083
 from shockcal.io import write_table
 from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
+from shockcal.study.strength import next_shot_targets
 from shockcal.study.validate import validate_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -66,7 +67,7 @@ def test_default_candidates_are_the_papers_question(paper_config):
     hot = [c for c in candidates.values() if c.get("initial_temperature_K")]
     assert len(candidates) == 7 and sorted(c["initial_temperature_K"] for c in hot) == [400, 500, 600, 700]
     assert {c["shot"] for c in candidates.values()} == {"104S", "105S", "106S"}
-    assert paper_config["next_shot"]["targets"] == ["A", "B", "C", "n", "m"] and paper_config["next_shot"]["n_draws"] == 200
+    assert next_shot_targets(paper_config) == ["A", "B", "C", "n", "m"] and paper_config["next_shot"]["n_draws"] == 200
     # a repeat keeps its shot's window; 104S's plates keep 104S's at any temperature
     assert candidate_config(paper_config, "105S-repeat")["analysis"]["window_after_arrival_us"] == 1.0
     assert candidate_config(paper_config, HOT)["analysis"]["window_after_arrival_us"] == 1.1

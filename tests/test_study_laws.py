@@ -13,6 +13,7 @@ from shockcal.errors import ConfigError
 from shockcal.hydro import LawShotParameters, ShotParameters
 from shockcal.study.adapters import emulator_spec, shot_mapping, study_design
 from shockcal.study.stages import stage_config
+from shockcal.study.strength import next_shot_targets
 from shockcal.study.validate import validate_config
 
 
@@ -44,6 +45,7 @@ def test_steinberg_guinan_box_and_mappings(paper_config):
                                       "V1", "V2", "V3"]
     assert config["inputs"]["Y0_GPa"] == {"min": 0.10, "max": 0.45, "unit": "GPa"}
     assert config["calibration"]["cube_power"] == {}
+    assert next_shot_targets(config) == list(config["inputs"])[:7]   # the next shot's default: the law's
     mapping = shot_mapping(config, "106S")
     assert mapping.shear_modulus_inputs == () and mapping.inputs()[-1] == "V3"
     design, _ = study_design(config, n_runs=8)

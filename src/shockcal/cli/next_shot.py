@@ -100,6 +100,7 @@ def run_suggest(args) -> int:
     from shockcal.seeds import stream_seed
     from shockcal.study.config import input_names
     from shockcal.study.stages import load_stage_config
+    from shockcal.study.strength import next_shot_targets
 
     config = load_stage_config(args.config, "suggest_shot")
     section = config["next_shot"]
@@ -118,6 +119,7 @@ def run_suggest(args) -> int:
                          "results/emulator/cv_rmse.csv), or set it to false")
     rmse = read_table(args.emulator_rmse) if section["emulator_error"] else None
     log = logging.getLogger("shockcal.next_shot")
+    targets = next_shot_targets(config)
     rows = []
     for name, spec in section["candidates"].items():
         design = check_design(read_table(designs[name]), names, designs[name])
@@ -125,7 +127,7 @@ def run_suggest(args) -> int:
                  emulator_rmse(rmse, spec["shot"], CALIBRATION_FEATURES, args.emulator_rmse))
         try:
             score = score_candidate(read_table(features[name]), design, CALIBRATION_FEATURES, parameters,
-                                    section["targets"], config["observed"]["sd_fraction"], np.hypot(readout, model),
+                                    targets, config["observed"]["sd_fraction"], np.hypot(readout, model),
                                     stream_seed(config["study"]["seed"], "next_shot", "eig", name))
         except InputError as exc:
             raise InputError(f"candidate {name} ({features[name]}): {exc}") from None
@@ -138,6 +140,6 @@ def run_suggest(args) -> int:
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(args.out) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
-    log.info("ranking (targets %s):\n%s", ", ".join(section["targets"]),
+    log.info("ranking (targets %s):\n%s", ", ".join(targets),
              table[["rank", "candidate", "eig_nats", "eig_sd", "overlaps_best"]].to_string(index=False))
     return 0

@@ -173,8 +173,9 @@ def _sobol(inputs, config):
 
 def _next_shot(inputs, config):
     from shockcal.plots.next_shot import next_shot_ranking
+    from shockcal.study.strength import next_shot_targets
 
-    return next_shot_ranking(inputs.table("next_shot_ranking"), list(config["next_shot"]["targets"]))
+    return next_shot_ranking(inputs.table("next_shot_ranking"), next_shot_targets(config))
 
 
 def history_names(config) -> dict[str, str]:
@@ -229,7 +230,7 @@ def catalogue(config) -> dict[str, FigureSpec]:
         # beyond the paper
         FigureSpec("sobol_indices", "6 sensitivity", _sobol, ("shots",), ("sobol",)),
         # which shot next (`make next-shot`), when the config has candidates
-        *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets",), ("next_shot_ranking",),
+        *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets", "strength.model?", "inputs"), ("next_shot_ranking",),
                       "next_shot")] if config.get("next_shot", {}).get("candidates") else []),
     ]
     return {spec.name: spec for spec in specs}

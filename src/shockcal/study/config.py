@@ -56,13 +56,17 @@ SHEAR_MODULUS_TO_MBAR = {"Mbar": 1.0, "GPa": 0.01, "kbar": 1e-3}
 
 def shear_modulus_box_Mbar(config: dict, shot: str) -> tuple[float, float] | None:
     """The smallest and largest shear modulus of `shot`'s prior box (Mbar, the sum of its
-    `shear_modulus_inputs`' bounds), or None when one of them is in a unit not in SHEAR_MODULUS_TO_MBAR."""
-    spec = shot_config(config, shot)
-    units = [str(config["inputs"][name]["unit"]).strip() for name in spec["shear_modulus_inputs"]]
+    `shear_modulus_inputs`' bounds; for a strength law with its own G law, which reads no shot moduli,
+    its G0_GPa box: G's rise with pressure left out), or None when one of them is in a unit not in
+    SHEAR_MODULUS_TO_MBAR."""
+    names = list(shot_config(config, shot)["shear_modulus_inputs"])
+    if not all(name in config["inputs"] for name in names) and "G0_GPa" in config["inputs"]:
+        names = ["G0_GPa"]
+    units = [str(config["inputs"][name]["unit"]).strip() for name in names]
     if any(unit not in SHEAR_MODULUS_TO_MBAR for unit in units):
         return None
     return tuple(sum(config["inputs"][name][end] * SHEAR_MODULUS_TO_MBAR[unit]
-                     for name, unit in zip(spec["shear_modulus_inputs"], units)) for end in ("min", "max"))
+                     for name, unit in zip(names, units)) for end in ("min", "max"))
 
 
 def plateau_us(config: dict, flyer_mm: float, target_mm: float, shear_modulus_Mbar: float) -> float:

@@ -70,7 +70,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "next_shot_simulate": ("hydro", *_CANDIDATE_BOX, *_CANDIDATE),
     "next_shot_features": ("features", *_CANDIDATE),
     # the candidates' information gains and their ranking
-    "suggest_shot": ("study.seed", "next_shot", "observed.sd_fraction", "inputs", "material.T_ref_K"),
+    "suggest_shot": ("study.seed", "next_shot", "observed.sd_fraction", "inputs", "material.T_ref_K", "strength.model?"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
     "figures": ("figures",),
 }

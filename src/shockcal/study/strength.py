@@ -32,6 +32,20 @@ def strength_model(config: dict) -> str:
     return (config.get("strength") or {}).get("model", DEFAULT_MODEL)
 
 
+def strength_parameters(config: dict) -> list[str]:
+    """The study's strength-law inputs: Johnson-Cook's A, B, C, n, m, or another law's boxed parameters."""
+    model = strength_model(config)
+    if model == DEFAULT_MODEL:
+        return list(JOHNSON_COOK_INPUTS)
+    return [p.name for p in get_law(model).params if p.name in config["inputs"]]
+
+
+def next_shot_targets(config: dict) -> list[str]:
+    """`next_shot.targets`, or every strength parameter of the study's law when it is null (the default)."""
+    targets = (config.get("next_shot") or {}).get("targets")
+    return strength_parameters(config) if targets is None else list(targets)
+
+
 def apply_strength_model(config: dict, source: str) -> None:
     """For a law other than Johnson-Cook: `inputs` becomes the law's box (declared units) followed by the
     shots' velocity inputs and, for a law without a G law, their shear-modulus inputs; `calibration.cube_power`

@@ -17,8 +17,8 @@ from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import load_study_design
-from shockcal.study.config import SHEAR_MODULUS_TO_MBAR, candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
-from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, strength_model
+from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
+from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -224,11 +224,12 @@ def check_next_shot(config: dict, source: str = "config") -> None:
     thin for it) and long enough for the plastic wave to arrive and rise (`PLASTIC_RISE_US`). The split
     of the elastic and plastic waves needs the posterior (`shockcal.candidates.check_split`)."""
     section, inputs = config["next_shot"], config["inputs"]
-    for target in section["targets"]:
+    targets = next_shot_targets(config)
+    for target in targets:
         if target not in inputs:
             raise ConfigError(f"{source}: next_shot.targets: unknown target '{target}'; the inputs are {sorted(inputs)}")
-    if len(set(section["targets"])) != len(section["targets"]):
-        raise ConfigError(f"{source}: next_shot.targets: {section['targets']} names a target twice")
+    if len(set(targets)) != len(targets):
+        raise ConfigError(f"{source}: next_shot.targets: {targets} names a target twice")
     slope = section["shear_modulus_log_slope_per_K"]
     if slope["min"] > slope["max"]:
         raise ConfigError(f"{source}: next_shot.shear_modulus_log_slope_per_K: min ({slope['min']:g}) is above max "
@@ -300,14 +301,9 @@ def check_window(config: dict, shot: str, source: str) -> None:
     read the release as part of the plateau. Shear-modulus inputs in a unit other than
     SHEAR_MODULUS_TO_MBAR's are not checked. A law with its own G law (SG, PTW) uses its G0_GPa box's
     maximum: the rise of G with pressure is left out, so this check is a little lenient for them."""
-    if _law_has_modulus(config):
-        unit = str(config["inputs"]["G0_GPa"]["unit"]).strip()
-        g_max = config["inputs"]["G0_GPa"]["max"] * SHEAR_MODULUS_TO_MBAR[unit] if unit in SHEAR_MODULUS_TO_MBAR else None
-    else:
-        box = shear_modulus_box_Mbar(config, shot)
-        g_max = None if box is None else box[1]
-    if g_max is not None:
-        check_window_fits(config, config["shots"][shot], g_max, f"{source}: shots.{shot}")
+    box = shear_modulus_box_Mbar(config, shot)
+    if box is not None:
+        check_window_fits(config, config["shots"][shot], box[1], f"{source}: shots.{shot}")
 
 
 def check_window_fits(config: dict, spec: dict, g_max_Mbar: float, where: str) -> None:
