@@ -6,7 +6,7 @@ The default, nautilus (J. U. Lange 2023, MNRAS 525, 3181: nested sampling whose 
 by neural networks, with every likelihood evaluation kept as an importance sample), needs no
 starting points, burn-in or tuning. It covers the whole box before it concentrates, so the modes of
 the joint posterior and its thin A-m arm are weighted by their mass, and it returns the evidence.
-It was chosen by measurement on the joint posterior of the paper's data (docs/calibration.md,
+It was chosen by measurement on the joint posterior of the paper's data (docs/journal/calibration.md,
 "Sampler choice"): against a long nautilus reference, the default settings put every quantile
 within 0.021 of the box, while smcpy's adaptive SMC put 7% or 53% of the mass in the A > 800 MPa
 arm (reference 67%) depending on its settings, and our earlier hand-built ensemble sampler almost
