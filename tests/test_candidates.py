@@ -288,6 +288,36 @@ def test_the_emulators_error_joins_the_noise_and_lowers_the_gain(tmp_path, two_c
     assert done.returncode == 2 and "no kfold RMSE of shot 104S's v_elastic" in done.stderr
 
 
+def test_a_candidate_takes_its_reference_shots_readout_error_unless_the_config_gives_one(tmp_path, two_candidates):
+    path, _, files = two_candidates
+    pairs = ["--designs", *(f"{n}={d}" for n, (d, _) in files.items()),
+             "--features", *(f"{n}={f}" for n, (_, f) in files.items())]
+    observed = tmp_path / "observed.parquet"
+    readout = {"readout_sd_v_elastic": 3.0, "readout_sd_v_plastic": 0.5, "readout_sd_v_slope1": 4.0,
+               "readout_sd_v_slope2": 1.0}
+    write_table(pd.DataFrame([{"shot": "104S", **readout}, {"shot": "105S", **{k: 0.0 for k in readout}}]), observed)
+    shockcal("suggest-shot", "--config", path, *pairs, "--out", tmp_path / "plain.csv")
+    done = shockcal("suggest-shot", "--config", path, *pairs, "--observed", observed, "--out", tmp_path / "r.csv")
+    assert done.returncode == 0, done.stderr
+    plain = pd.read_csv(tmp_path / "plain.csv").set_index("candidate")
+    with_readout = pd.read_csv(tmp_path / "r.csv").set_index("candidate")
+    for name in ("cold", "hot"):                                    # both candidates' reference shot is 104S
+        for feature in CALIBRATION_FEATURES:
+            noise = plain.loc[name, f"noise_sd_{feature}"]
+            assert with_readout.loc[name, f"noise_sd_{feature}"] == pytest.approx(
+                math.hypot(noise, readout[f"readout_sd_{feature}"]), rel=0.02)
+        assert with_readout.loc[name, "eig_nats"] < plain.loc[name, "eig_nats"]
+    text = yaml.safe_load(path.read_text())                       # a value in the config wins over the table's
+    text["next_shot"]["readout_sd_m_s"] = {"v_slope1": 0.0}
+    path.write_text(yaml.safe_dump(text))
+    shockcal("suggest-shot", "--config", path, *pairs, "--observed", observed, "--out", tmp_path / "given.csv")
+    given = pd.read_csv(tmp_path / "given.csv").set_index("candidate")
+    assert given.loc["cold", "noise_sd_v_slope1"] == pytest.approx(plain.loc["cold", "noise_sd_v_slope1"], rel=0.02)
+    write_table(pd.DataFrame([{"shot": "105S", **readout}]), observed)
+    done = shockcal("suggest-shot", "--config", path, *pairs, "--observed", observed, "--out", tmp_path / "x.csv")
+    assert done.returncode == 2 and "observed.parquet: no row for shot 104S" in done.stderr
+
+
 def test_missing_posterior_and_missing_features_are_one_line(tmp_path, two_candidates):
     path, _, files = two_candidates
     done = shockcal("next-shot-design", "--config", path, "--candidate", "cold", "--posterior", tmp_path / "none.parquet",

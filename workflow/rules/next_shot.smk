@@ -25,7 +25,7 @@ rule next_shot_design:
         settings=lambda w: stage_config(config, "next_shot_design", w.shot),
     shell:
         "shockcal next-shot-design --candidate {wildcards.shot} --posterior {input.posterior}"
-        " --out {output} > {log} 2>&1"
+        " --observed {input.observed} --out {output} > {log} 2>&1"
 
 
 rule suggest_shot:
@@ -33,6 +33,7 @@ rule suggest_shot:
         designs=expand(rules.next_shot_design.output[0], shot=CANDIDATES),
         features=expand(rules.features.output[0], run_set="next_shot", shot=CANDIDATES),
         rmse=rules.emulator.output.rmse if config["next_shot"]["emulator_error"] else [],
+        observed=rules.observed.output[0],
     output:
         f"{RESULTS}/next_shot/ranking.csv",
     log:

@@ -6,8 +6,10 @@ for every candidate), after checking that the candidate's waves split (`check_sp
 through `shockcal simulate --candidate` and `shockcal features --candidate`.
 suggest-shot reads every candidate's design and features and writes the ranking (CSV): per candidate
 the expected information gain about next_shot.targets (noise: observed.sd_fraction of each feature,
-with next_shot.readout_sd_m_s and, with next_shot.emulator_error, the emulator's K-fold RMSE of the
-reference shot's features, in quadrature), its bootstrap sd, the full-theta bracket,
+with the extractor's read-out sd and, with next_shot.emulator_error, the emulator's K-fold RMSE of the
+reference shot's features, in quadrature; the read-out sd of a feature is next_shot.readout_sd_m_s's
+value where given, else the reference shot's `readout_sd_<feature>` in the observed table), its
+bootstrap sd, the full-theta bracket,
 each target's marginal gain and expected posterior sd, the features' spread against the measurement
 noise. Config keys: next_shot, observed.sd_fraction, study.seed, inputs.
 """
@@ -32,6 +34,9 @@ def register(subparsers) -> None:
     s.add_argument("--features", nargs="+", required=True, help="CANDIDATE=FEATURES pairs (their runs' features)")
     s.add_argument("--emulator-rmse", help="the emulator's cross-validation RMSE table (emulator/cv_rmse.csv), "
                    "needed with next_shot.emulator_error")
+    s.add_argument("--observed", help="the measured features (features/observed.parquet): each candidate's "
+                   "read-out sd is its reference shot's readout_sd_<feature> where next_shot.readout_sd_m_s "
+                   "gives none; without it such a feature's read-out sd is 0")
     s.add_argument("--out", required=True, help="output ranking CSV (results/next_shot/ranking.csv)")
     s.set_defaults(func=run_suggest)
 
@@ -87,6 +92,26 @@ def emulator_rmse(table, shot: str, features, source: str):
     return rows.loc[list(features), "rmse_m_s"].to_numpy(dtype=float)
 
 
+def candidate_readout_sd(given: dict, observed, shot: str, features, source: str):
+    """A candidate's read-out sd per feature (m/s): next_shot.readout_sd_m_s's value where `given` has the
+    feature, else the reference `shot`'s `readout_sd_<feature>` in the `observed` table (a candidate has no
+    record yet; its reference shot's read-out error is the cautious stand-in), else 0 (no table, or a
+    table without read-out columns: a published one)."""
+
+    import numpy as np
+
+    from shockcal.errors import InputError
+    from shockcal.problem import readout_vector
+
+    if observed is None:
+        reference = np.zeros(len(features))
+    elif shot not in set(observed["shot"].astype(str).str.strip()):
+        raise InputError(f"{source}: no row for shot {shot} (a candidate's reference shot)")
+    else:
+        reference = readout_vector(observed, [shot], list(features), source)
+    return np.array([given.get(f, r) for f, r in zip(features, reference)], dtype=float)
+
+
 def run_suggest(args) -> int:
     import logging
     from pathlib import Path
@@ -113,7 +138,7 @@ def run_suggest(args) -> int:
                                               f"{unknown} are not candidates of next_shot.candidates"))
     names = input_names(config)
     parameters = [*names, VELOCITY_FACTOR, SLOPE]
-    readout = np.array([section["readout_sd_m_s"].get(f, 0.0) for f in CALIBRATION_FEATURES])
+    observed = read_table(args.observed) if args.observed else None
     if section["emulator_error"] and not args.emulator_rmse:
         raise InputError("next_shot.emulator_error is true: give the emulator's RMSE table (--emulator-rmse "
                          "results/emulator/cv_rmse.csv), or set it to false")
@@ -125,6 +150,8 @@ def run_suggest(args) -> int:
         design = check_design(read_table(designs[name]), names, designs[name])
         model = (np.zeros(len(CALIBRATION_FEATURES)) if rmse is None else
                  emulator_rmse(rmse, spec["shot"], CALIBRATION_FEATURES, args.emulator_rmse))
+        readout = candidate_readout_sd(section["readout_sd_m_s"], observed, spec["shot"], CALIBRATION_FEATURES,
+                                       args.observed)
         try:
             score = score_candidate(read_table(features[name]), design, CALIBRATION_FEATURES, parameters,
                                     targets, config["observed"]["sd_fraction"], np.hypot(readout, model),
