@@ -73,3 +73,20 @@ def run_set_settings(stage):
 def simulations(run_set, shot):
     """Every simulation chunk of one run set's shot."""
     return expand(rules.simulate.output[0], run_set=run_set, shot=shot, chunk=RUN_SET_CHUNKS[run_set])
+
+
+# The next-shot check (next_shot_check.smk): a model is "baseline" (the three shots) or a compared candidate
+# (design.smk's CHECK_PLANS: the four).
+def check_model_config(model):
+    """`--config` of a check job: the derived study's for a candidate, none (the study's) for the baseline."""
+    return f"--config {CHECK_PLANS[model]['config']}" if model in CHECK_PLANS else ""
+
+
+def check_model_shots(model):
+    """The shots a check model calibrates: the study's, and the candidate as the fourth."""
+    return [*SHOTS, *([model] if model in CHECK_PLANS else [])]
+
+
+def check_model_settings(stage):
+    """The rule param of `stage`'s config slice in the model's study."""
+    return lambda w: stage_config(CHECK_PLANS[w.model]["study"] if w.model in CHECK_PLANS else config, stage)

@@ -9,21 +9,6 @@ CHECK_SECTION = config["next_shot"]["check"]
 CHECK_MODELS = ["baseline", *CHECK_PLANS]
 
 
-def check_model_config(model):
-    """`--config` of a check job: the derived study's for a candidate, none (the study's) for the baseline."""
-    return f"--config {CHECK_PLANS[model]['config']}" if model in CHECK_PLANS else ""
-
-
-def check_model_shots(model):
-    """The shots a check model calibrates: the study's, and the candidate as the fourth."""
-    return [*SHOTS, *([model] if model in CHECK_PLANS else [])]
-
-
-def check_model_settings(stage):
-    """The rule param of `stage`'s config slice in the model's study."""
-    return lambda w: stage_config(CHECK_PLANS[w.model]["study"] if w.model in CHECK_PLANS else config, stage)
-
-
 rule next_shot_check_truths:
     """The check's truths: next_shot.check.n_truths joint-posterior draws, with each candidate's inputs."""
     input:
