@@ -10,7 +10,7 @@ LOCKED_PYTHON := 3.11
 CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick models models-quick check next-shot test test-slow test-slurm bench validate lint lock clean
+.PHONY: study quick models models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 $(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -48,6 +48,10 @@ check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (ca
 next-shot: $(INSTALLED)  ## which shot next (issue 38): rank next_shot.candidates by expected information gain
 	snakemake --cores $(CORES) next_shot
 	@echo "ranking: $(CURDIR)/results/next_shot/ranking.csv"
+
+next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: its best and worst candidates on truths from the posterior
+	snakemake --cores $(CORES) next_shot_check
+	@echo "check: $(CURDIR)/results/next_shot/check_summary.csv"
 
 test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 	$(VENV)/bin/pytest

@@ -37,6 +37,7 @@ include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/predict.smk"
 include: "workflow/rules/sensitivity.smk"
 include: "workflow/rules/next_shot.smk"
+include: "workflow/rules/next_shot_check.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/report.smk"
 
@@ -53,3 +54,10 @@ rule next_shot:
     input:
         rules.suggest_shot.output,
         TARGET_FIGURES.get("next_shot", []),
+
+
+rule next_shot_check:
+    """The realized check of the ranking (issue 38): `make next-shot-check`, outside `all` (docs/next_shot.md,
+    "The realized check": its cost)."""
+    input:
+        rules.next_shot_check_summary.output if CHECK_PLANS else [],

@@ -124,9 +124,11 @@ def test_shot_without_emulator_is_rejected(small_config):
 
 def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
     _, _, trials = three_toy_trials
-    assert list(trials.columns) == ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass",
-                                    "status", "reason"]
-    assert (trials["status"] == "ok").all() and (trials["reason"] == "").all()
+    assert list(trials.columns) == ["trial", "run", "parameter", "truth", "q05", "q95", "sd", "inside", "ess",
+                                    "truth_hpd_mass", "status", "reason"]
+    assert (trials["status"] == "ok").all() and (trials["reason"] == "").all() and trials["run"].isna().all()
+    # a 90% interval spans about 3.3 sd for a Gaussian posterior: a loose bracket of the sd against it
+    assert ((trials["q95"] - trials["q05"]) / trials["sd"]).between(2.0, 4.5).all()
     assert len(trials) == 3 * 3 and (trials["q05"] < trials["q95"]).all() and (trials["ess"] >= 300).all()
     per_trial = trials.groupby("trial")["truth_hpd_mass"]
     assert (per_trial.nunique() == 1).all() and trials["truth_hpd_mass"].between(0.0, 1.0).all()

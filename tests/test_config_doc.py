@@ -65,7 +65,7 @@ def test_reruns_come_from_the_stage_declarations():
     assert reruns(("calibration", "n_live")) == "calibrate"
     assert reruns(("shots", "<shot>", "analysis", "cutoff_after_arrival_us")).startswith(
         "features (its shot); failure_budget (its shot); observed; next_shot_design; next_shot_simulate; "
-        "next_shot_features; figures ")
+        "next_shot_features; next_shot_check_truths; figures ")
     assert "simulate (shots that read it)" in reruns(("inputs", "<input>", "min"))
     assert reruns(("observed", "sd_fraction")) == "calibrate; calibrate_check; suggest_shot; figures 9, 10"
     assert reruns(("figures", "dpi")) == "figures"

@@ -143,6 +143,29 @@ def test_cli_fits_on_tables_and_writes_cv(tmp_path, paper_config):
                  "--features", "104S", "--out", str(tmp_path / "x")]) == 2
 
 
+def test_cli_first_runs_fits_on_the_designs_first_rows_only(tmp_path, paper_config, capsys):
+    """`emulate --first-runs N` (the next-shot check's emulators): the design's first N rows, later runs' features
+    left out; N outside 1..rows is one line."""
+    import yaml
+
+    from shockcal.cli import main
+    from shockcal.emulator import Emulator
+
+    design, features, _ = _synthetic_study(paper_config, n=30)
+    design.to_csv(tmp_path / "design.csv", index=False)
+    features.to_parquet(tmp_path / "f.parquet")
+    paper_config["emulator"].update(n_starts=1, cv_folds=3)
+    (tmp_path / "c.yaml").write_text(yaml.safe_dump(paper_config))
+    common = ["emulate", "--config", str(tmp_path / "c.yaml"), "--design", str(tmp_path / "design.csv"),
+              "--features", f"104S={tmp_path / 'f.parquet'}"]
+    assert main([*common, "--first-runs", "20", "--out", str(tmp_path / "emu")]) == 0
+    runs = Emulator.load(tmp_path / "emu").blocks[0].runs
+    assert sorted(runs) == sorted(design["run"].iloc[:20])
+    assert main([*common, "--first-runs", "31", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--first-runs: 31 is not between 1 and the design's 30 rows" in err[0]
+
+
 def test_features_of_a_shot_the_spec_does_not_map_are_rejected(paper_config):
     design, features, _ = _synthetic_study(paper_config, n=30)
     with pytest.raises(InputError, match=r"features of shots \['106S'\]: the emulator spec maps only \['104S'\]"):

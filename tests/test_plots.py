@@ -149,6 +149,13 @@ def test_feature_space(source, tmp_path):
     _save_png(fig, tmp_path)
 
 
+def test_the_measured_band_is_the_likelihoods_observation_sd():
+    """1% of the value and the record's read-out sd in quadrature; 1% alone without a read-out column."""
+    row = pd.Series({"v_slope1": 80.0, "readout_sd_v_slope1": 0.6, "v_plastic": 200.0})
+    assert feature_space.observation_sd(row, "v_slope1", 0.01) == pytest.approx(1.0)
+    assert feature_space.observation_sd(row, "v_plastic", 0.01) == pytest.approx(2.0)
+
+
 def test_failed_runs_are_left_out():
     table = _features(5, 0)
     assert len(feature_space.usable(table)) == 4

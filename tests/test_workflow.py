@@ -390,3 +390,39 @@ def test_make_quick_names_its_target_before_the_configfile():
     command = next(line.split() for line in lines.splitlines() if line.startswith("snakemake "))
     done = subprocess.run([SNAKEMAKE, "--dry-run", *command[1:]], cwd=REPO, capture_output=True, text=True)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+
+
+def test_the_next_shot_check_without_a_ranking_stops_with_one_line(tmp_path):
+    """`snakemake next_shot_check` compares the ranking's best and worst: with no ranking.csv it stops before any job."""
+    fresh = overlay(tmp_path / "fresh.yaml", study={"results_dir": str(tmp_path / "results")})
+    done = snakemake("next_shot_check", "--dry-run", config_files=[fresh], check=False)
+    errors = [line for line in (done.stdout + done.stderr).splitlines() if line.startswith("shockcal: error:")]
+    assert done.returncode != 0 and len(errors) == 1 and "ranking.csv: missing" in errors[0], done.stderr[-2000:]
+    assert "Traceback" not in done.stdout + done.stderr
+
+
+@pytest.mark.slow   # the last of this module's tests: its outputs would join the seed and noise tests' params checks
+def test_next_shot_check_target_on_the_quick_study(study):
+    """`snakemake next_shot_check` on the quick study (quick.yaml: 3 truths, 20 training runs per candidate): both
+    candidates as fourth shots, their runs at the first 20 training rows and at the truths (the three shots'
+    training runs reused, not rerun), the per-truth table and the summary with its verdicts; `all` untouched."""
+    results, config = study
+    snakemake("next_shot", "--cores", "2", config_files=[config])
+    ranking = pd.read_csv(results / "next_shot" / "ranking.csv")
+    snakemake("next_shot_check", "--cores", "2", config_files=[config])
+    check = pd.read_csv(results / "next_shot" / "check.csv")
+    assert set(check["candidate"]) == set(ranking["candidate"]) and check["run"].nunique() == 3
+    sds = [f"{k}sd_{p}" for k in ("", "baseline_") for p in ("A", "B", "C", "n", "m")]
+    assert np.isfinite(check["gain_nats"]).all() and (check[sds] > 0).all().all()
+    summary = pd.read_csv(results / "next_shot" / "check_summary.csv")
+    best, worst = ranking["candidate"].iloc[0], ranking["candidate"].iloc[-1]
+    difference = summary[summary["row"] == f"{best} - {worst}"]
+    assert set(difference["quantity"]) == {"gain_nats", *(f"ln_sd_{p}" for p in ("A", "B", "C", "n", "m"))}
+    assert set(difference["verdict"]) <= {"holds", "does not hold"} and (difference["n_truths"] == 3).all()
+    gain = summary.set_index(["row", "quantity"]).loc[(best, "gain_nats")]
+    assert gain["predicted"] == pytest.approx(ranking["eig_nats"].iloc[0], rel=1e-5)
+    for name in (best, worst):                                  # 20 runs in 2 chunks of 10; the truths in 1
+        assert len(pd.read_parquet(results / "next_shot_check" / "features" / f"{name}.parquet")) == 20
+        assert len(list((results / "next_shot_check" / "simulations" / name).glob("chunk-*.parquet"))) == 2
+    assert not (results / "next_shot_check" / "simulations" / "104S").exists()
+    assert pending_jobs(config) == {} and pending_jobs(config, target="next_shot_check") == {}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -19,7 +20,8 @@ from shockcal.progress import progress
 log = logging.getLogger("shockcal.calibration")
 
 
-def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None) -> pd.DataFrame:
+def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None,
+                    draws: list | None = None) -> pd.DataFrame:
     """Calibrate on synthetic truth with a known theta; one row per trial and parameter.
 
     `trials` is a count or the trial numbers to run (a range): each trial draws from its own random
@@ -27,10 +29,13 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     gives the same rows as one run. A trial draws lambda_y from its prior and takes theta and
     noise-free features either from the emulator (theta uniform on the box, features from its
     predictive distribution at theta) or, when `truths` is given, from hydrocode run number `trial`
-    among the usable ones (`HydroTruths`). Observation noise of sd = sd_fraction / sqrt(lambda_y) of
-    each feature is added and the features are calibrated with `settings` (the sampler reseeded from
-    the trial's stream). Columns:
-    trial, parameter, truth, q05, q95, inside (the 90% interval holds the truth), ess (Kish ESS),
+    among the usable ones (`HydroTruths`; its design's `lambda_y` when the design has one, e.g. truths
+    drawn from a posterior). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is
+    added and the features are calibrated with `settings` (the sampler reseeded from the trial's
+    stream). With `draws` (a list), each finished trial's equal-weight posterior draws are appended to
+    it as a table with `trial` and `run` columns. Columns:
+    trial, run (the truth's hydrocode run; empty for emulator truth), parameter, truth, q05, q95, sd
+    (posterior sd), inside (the 90% interval holds the truth), ess (Kish ESS),
     truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows), status ("ok" or
     "failed") and reason. A trial that fails (the sampler at `max_evaluations`, no positive noise draw)
     is recorded with its reason and empty results, and the next one runs; the coverage leaves it out
@@ -50,7 +55,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     for done, trial in enumerate(batch, 1):
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(trial,)))
         try:
-            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws, box)
+            rows += _trial_rows(emulator, shots, names, settings, trial, rng, hydro_draws, box, draws)
         except ShockcalError as error:     # recorded and left out of the coverage, never the end of the batch
             log.warning("synthetic trial %d failed: %s", trial, error)
             rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
@@ -61,28 +66,33 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     return table
 
 
-CHECK_COLUMNS = ["trial", "parameter", "truth", "q05", "q95", "inside", "ess", "truth_hpd_mass", "status", "reason"]
+CHECK_COLUMNS = ["trial", "run", "parameter", "truth", "q05", "q95", "sd", "inside", "ess", "truth_hpd_mass", "status",
+                 "reason"]
 
 
-def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws, box) -> list[dict]:
+def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rng, hydro_draws, box,
+                draws: list | None = None) -> list[dict]:
     """One synthetic-truth trial: its truth, pseudo-measurement and calibration; a row per parameter."""
     if hydro_draws is None:
         theta, eta = _emulator_truth(emulator, shots, names, rng, box)
+        run, lam = None, None
     else:
-        theta, eta = hydro_draws[trial]
-    lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial)
+        theta, eta, run, lam = hydro_draws[trial]
+    lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial, lam)
     observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
     trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
     posterior = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
-    draws, summary = posterior.draws, posterior.summary().set_index("parameter")
+    draws_table, summary = posterior.draws, posterior.summary().set_index("parameter")
+    if draws is not None:
+        draws.append(draws_table.assign(trial=trial, run=run))
     problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)
     truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
-    mass = hpd_mass(log_density(draws["log_likelihood"], draws["lambda_y"]), log_density(truth_ll, lam))
+    mass = hpd_mass(log_density(draws_table["log_likelihood"], draws_table["lambda_y"]), log_density(truth_ll, lam))
     rows = []
     for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
         q05, q95 = summary.loc[name, ["q05", "q95"]]
-        rows.append({"trial": trial, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
-                     "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
+        rows.append({"trial": trial, "run": run, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
+                     "sd": summary.loc[name, "sd"], "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
                      "truth_hpd_mass": mass, "status": "ok", "reason": ""})
     return rows
 
@@ -94,12 +104,13 @@ def hpd_mass(draw_log_density, truth_log_density: float) -> float:
     return float(np.mean(np.asarray(draw_log_density) > truth_log_density))
 
 
-def _noisy_features(eta, sd_fraction, rng, trial, attempts: int = 100):
-    """(lambda_y, pseudo-measured features): lambda_y from its prior and noise of sd = sd_fraction /
-    sqrt(lambda_y) of each feature. No measurement reports a non-positive feature: such a draw is
-    drawn again (the features are conditioned on being positive)."""
+def _noisy_features(eta, sd_fraction, rng, trial, lam=None, attempts: int = 100):
+    """(lambda_y, pseudo-measured features): lambda_y as given (the truth's) or from its prior, and noise
+    of sd = sd_fraction / sqrt(lambda_y) of each feature. No measurement reports a non-positive feature:
+    such a draw is drawn again (the features are conditioned on being positive)."""
+    given = lam
     for _ in range(attempts):
-        lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1])
+        lam = rng.gamma(LAMBDA_Y_PRIOR[0], 1.0 / LAMBDA_Y_PRIOR[1]) if given is None else given
         y = eta + sd_fraction * np.abs(eta) / np.sqrt(lam) * rng.normal(size=eta.shape)
         if np.all(y > 0):
             return lam, y
@@ -117,6 +128,15 @@ def _emulator_truth(emulator, shots, names, rng, box):
     for cols, error in emulator.error_groups(shots):
         features[cols] = error.sample(mean[0, cols], cov[0, cols[:, None], cols[None, :]], rng)
     return theta, features
+
+
+class Truth(NamedTuple):
+    """One hydrocode truth: its inputs, its runs' features (every shot's, m/s), its run id, its lambda_y or None."""
+
+    theta: np.ndarray
+    features: np.ndarray
+    run: int
+    lambda_y: float | None
 
 
 @dataclass
@@ -143,8 +163,9 @@ class HydroTruths:
             check_unique(tables[path], "run", path, "run")
         return cls(tables[design_path], {shot: tables[path] for shot, path in feature_paths.items()})
 
-    def table(self, names, shots) -> list:
-        """(theta, features) of each usable run (every shot's features ok and positive), in run order."""
+    def table(self, names, shots) -> list[Truth]:
+        """A `Truth` per usable run (every shot's features ok and positive), in run order; its lambda_y is
+        the design's `lambda_y` when it has one, else None (drawn from the prior)."""
         table = self.design.set_index("run")
         for shot in shots:
             ok = self.features[shot].query("status == 'ok'").set_index("run")
@@ -152,7 +173,9 @@ class HydroTruths:
         columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES]
         usable = table[(table[columns] > 0).all(axis=1)].sort_index()
         log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable), len(self.design))
-        return list(zip(usable[names].to_numpy(float), usable[columns].to_numpy(float)))
+        lam = usable["lambda_y"].to_numpy(float) if "lambda_y" in usable else [None] * len(usable)
+        return [Truth(*row) for row in zip(usable[names].to_numpy(float), usable[columns].to_numpy(float),
+                                           usable.index.to_numpy(int).tolist(), lam)]
 
 
 def usable_trials(trials: pd.DataFrame) -> pd.DataFrame:

@@ -18,7 +18,7 @@ keyed further (an emulator block index, a calibration's shots).
 | design_extension | the column of an input only a later shot reads (`design.base_shots`), keyed by shot and input |
 | sensitivity | the Sobol sequence's scrambling and the bootstrap of the Sobol indices |
 | readout | the noise replicates of a measured record's read-out bootstrap (`shockcal observed`), keyed by shot |
-| next_shot | the draws run at every next-shot candidate (key "draws"); each candidate's information gain ("eig", name) |
+| next_shot | candidates' draws ("draws"), gains ("eig", name); the check's truths ("check_truths"), noise ("check_noise") |
 """
 from __future__ import annotations
 

@@ -1,11 +1,14 @@
 # Helpers shared by every rule file (the effective config, chunking, config slices, run-set paths).
 import hashlib
 import os
+import sys
 
 import yaml
 
 from shockcal.design import chunk_fingerprints, write_design
+from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
+from shockcal.study.next_shot_check import plan_check
 from shockcal.study.stages import figure_config, stage_config
 from shockcal.workflow import (
     chunk_count,
@@ -39,11 +42,16 @@ def run_set_path(run_set, *parts):
 
 def run_set_design(wildcards):
     """The design a run set's chunks read: the training design is planned at parse time (ancient); a
-    next-shot candidate has its own (next_shot.smk)."""
+    next-shot candidate has its own (next_shot.smk), and so has a compared candidate of the next-shot check
+    (its derived study's training design, planned at parse time; its truths, next_shot_check.smk)."""
     if wildcards.run_set == "training":
         return ancient(DESIGN)
     if wildcards.run_set == "next_shot":
         return run_set_path("next_shot", "designs", f"{wildcards.shot}.parquet")
+    if wildcards.run_set == "next_shot_check":
+        return ancient(CHECK_PLANS[wildcards.shot]["design"])
+    if wildcards.run_set == "next_shot_truth" and wildcards.shot not in SHOTS:
+        return run_set_path("next_shot_truth", "designs", f"{wildcards.shot}.parquet")
     return run_set_path(wildcards.run_set, "design.parquet")
 
 
@@ -57,10 +65,28 @@ CANDIDATE_STAGES = {
 
 
 def run_set_settings(stage):
-    """The rule param of `stage`'s config slice for the job's shot, or its candidate's in the run set next_shot."""
-    return lambda w: stage_config(config, CANDIDATE_STAGES[stage] if w.run_set == "next_shot" else stage, w.shot)
+    """The rule param of `stage`'s config slice for the job's shot, or its candidate's stage for a next-shot
+    candidate (the run sets next_shot, next_shot_check and next_shot_truth)."""
+    return lambda w: stage_config(config, stage if w.shot in SHOTS else CANDIDATE_STAGES[stage], w.shot)
 
 
 def simulations(run_set, shot):
     """Every simulation chunk of one run set's shot."""
     return expand(rules.simulate.output[0], run_set=run_set, shot=shot, chunk=RUN_SET_CHUNKS[run_set])
+
+
+# The next-shot check (next_shot_check.smk): a model is "baseline" (the three shots) or a compared candidate
+# (design.smk's CHECK_PLANS: the four).
+def check_model_config(model):
+    """`--config` of a check job: the derived study's for a candidate, none (the study's) for the baseline."""
+    return f"--config {CHECK_PLANS[model]['config']}" if model in CHECK_PLANS else ""
+
+
+def check_model_shots(model):
+    """The shots a check model calibrates: the study's, and the candidate as the fourth."""
+    return [*SHOTS, *([model] if model in CHECK_PLANS else [])]
+
+
+def check_model_settings(stage):
+    """The rule param of `stage`'s config slice in the model's study."""
+    return lambda w: stage_config(CHECK_PLANS[w.model]["study"] if w.model in CHECK_PLANS else config, stage)

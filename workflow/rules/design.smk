@@ -31,4 +31,27 @@ RUN_SET_SIZES = {
     "check": config["calibration"]["check"]["trials"],
     "next_shot": config["next_shot"]["n_draws"],
 }
+
+# The next-shot check (next_shot_check.smk): each compared candidate as the fourth shot of a study derived from
+# the config (its config file and training design: the study's, the candidate's inputs drawn as new columns),
+# planned here as the training design is. Without a ranking yet there is none, unless the check is the target on
+# the command line (snakemake has not read its targets yet when it reads this file): then it stops with one line.
+try:
+    CHECK_PLANS = plan_check(
+        config,
+        f"{RESULTS}/next_shot/ranking.csv",
+        DESIGN,
+        run_set_path("next_shot_check"),
+        required="next_shot_check" in sys.argv[1:],
+    )
+except ShockcalError as exc:
+    raise SystemExit(f"shockcal: error: {exc}") from None
+CHECK_DIGESTS = {
+    name: chunk_fingerprints(plan["table"][["run", *shot_mapping(plan["study"], name).inputs()]], CHUNK_SIZE)
+    for name, plan in CHECK_PLANS.items()
+}
+#   next_shot_check: the compared candidates' training runs, the first next_shot.check.n_training_runs rows of
+#             their derived studies' designs; next_shot_truth: the check's truths at the shots and the candidates.
+RUN_SET_SIZES["next_shot_check"] = config["next_shot"]["check"]["n_training_runs"]
+RUN_SET_SIZES["next_shot_truth"] = config["next_shot"]["check"]["n_truths"]
 RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SET_SIZES.items()}

@@ -25,7 +25,7 @@ rule next_shot_design:
         settings=lambda w: stage_config(config, "next_shot_design", w.shot),
     shell:
         "shockcal next-shot-design --candidate {wildcards.shot} --posterior {input.posterior}"
-        " --observed {input.observed} --out {output} > {log} 2>&1"
+        " --out {output} > {log} 2>&1"
 
 
 rule suggest_shot:
@@ -49,4 +49,4 @@ rule suggest_shot:
         rmse=lambda w, input: f"--emulator-rmse {input.rmse}" if input.rmse else "",
     shell:
         "shockcal suggest-shot --designs {params.designs} --features {params.features} {params.rmse}"
-        " --out {output} > {log} 2>&1"
+        " --observed {input.observed} --out {output} > {log} 2>&1"

@@ -21,8 +21,14 @@ rule simulate:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("simulate"),
-        rows=lambda w: chunk_rows(w.chunk, CHUNK_SIZE),
-        rows_digest=lambda w: CHUNK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "training" else "",
+        rows=lambda w: chunk_rows(
+            w.chunk, CHUNK_SIZE, RUN_SET_SIZES[w.run_set] if w.run_set == "next_shot_check" else None
+        ),
+        rows_digest=lambda w: (
+            CHUNK_DIGESTS[w.shot][int(w.chunk)]
+            if w.run_set == "training"
+            else CHECK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "next_shot_check" else ""
+        ),
         end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"

@@ -26,6 +26,7 @@ STAGE_MODULES = [
     "shockcal.cli.posterior_netcdf",
     "shockcal.cli.predict",
     "shockcal.cli.next_shot",
+    "shockcal.cli.next_shot_check",
     "shockcal.cli.sensitivity",
     "shockcal.cli.figures",
     "shockcal.cli.report",

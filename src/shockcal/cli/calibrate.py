@@ -34,6 +34,12 @@ def register(subparsers) -> None:
     c.add_argument("--truth-design", help="hydrocode truth: design table of the truth runs (CSV or Parquet)")
     c.add_argument("--truth-features", nargs="+", metavar="SHOT=TABLE",
                    help="hydrocode truth: the features of the truth runs per shot (with --truth-design)")
+    c.add_argument("--seed-stream", nargs="+", metavar="KEY",
+                   help="the trials' seed stream of study.seed (default: check, the truth, the shots); calibrations "
+                        "of other shots on one stream see the same noise on the shots they share")
+    c.add_argument("--n-live", type=int, help="override calibration.check.n_live")
+    c.add_argument("--n-eff", type=int, help="override calibration.check.n_eff (and the draws kept)")
+    c.add_argument("--draws-out", help="also write every trial's equal-weight posterior draws (Parquet; trial, run)")
     c.set_defaults(func=run_check)
 
     m = subparsers.add_parser("coverage", help="merge per-trial tables of calibrate-check batches; print the coverage")
@@ -101,6 +107,7 @@ def run_check(args) -> int:
     import logging
 
     from shockcal.coverage import coverage_table, synthetic_truth
+    from shockcal.errors import InputError
     from shockcal.io import write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import calibration_settings
@@ -114,11 +121,27 @@ def run_check(args) -> int:
     emulator = study_emulator(args.emulator, config)
     truth = "emulator" if truths is None else "hydrocode"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
-    table = synthetic_truth(emulator, args.shots,
-                            calibration_settings(config, args.shots, check=True), trials,
-                            seed=stream_seed(config["study"]["seed"], "check", truth, *args.shots), truths=truths)
+    stream = args.seed_stream or ["check", truth, *args.shots]
+    try:
+        seed = stream_seed(config["study"]["seed"], *stream)
+    except ValueError as exc:
+        raise InputError(f"--seed-stream: {exc}") from None
+    draws = [] if args.draws_out else None
+    settings = calibration_settings(config, args.shots, check=True)
+    if args.n_live is not None:
+        settings = settings.with_sampler(n_live=args.n_live)
+    if args.n_eff is not None:
+        settings = settings.with_sampler(n_eff=args.n_eff, draws=args.n_eff)
+    table = synthetic_truth(emulator, args.shots, settings, trials, seed=seed, truths=truths, draws=draws)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
+    if draws is not None:
+        import pandas as pd
+
+        if not draws:
+            raise InputError(f"calibrate-check: no trial finished, no draws for {args.draws_out}")
+        write_table(pd.concat(draws, ignore_index=True), args.draws_out,
+                    {"table": "synthetic-truth posterior draws", "shots": args.shots, "truth": source})
     log_coverage(coverage_table(table), table)
     return 0
 

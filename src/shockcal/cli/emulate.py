@@ -20,6 +20,9 @@ def register(subparsers) -> None:
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
                    help="per-shot feature tables (CSV or Parquet), joined to the design on `run`")
     p.add_argument("--structure", choices=["per_shot", "joint"], help="override emulator.structure")
+    p.add_argument("--first-runs", type=int, metavar="N",
+                   help="fit on the design's first N rows only; the features of later runs are left out "
+                        "(the next-shot check's emulators)")
     p.add_argument("--out", required=True,
                    help="output directory (emulator.json, emulator.npz, cv.parquet, cv_heldout.parquet, cv_rmse.csv)")
     p.set_defaults(func=run)
@@ -49,6 +52,15 @@ def run(args) -> int:
         spec = replace(spec, structure=args.structure)
     design = load_study_design(args.design, config)
     features = {shot: read_table(path) for shot, path in paths.items()}
+    if args.first_runs is not None:
+        from shockcal.errors import InputError
+
+        if not 0 < args.first_runs <= len(design):
+            raise InputError(f"--first-runs: {args.first_runs} is not between 1 and the design's {len(design)} rows "
+                             f"({args.design})")
+        design = design.iloc[:args.first_runs]
+        features = {shot: table[table["run"].isin(design["run"])] if "run" in table else table
+                    for shot, table in features.items()}
     emulator = fit_emulator(design, features, spec, sources=paths)
     out = Path(args.out)
     emulator.save(out)

@@ -3,8 +3,9 @@ predictions (through the emulator for 9, through the hydrocode for 10) and the m
 
 One row per shot, one column per calibration feature (elastic plateau, plastic plateau, slope
 points 1 and 2, all velocities in m/s): densities of the training runs (grey) and of the posterior
-predictions (blue), the measured value as a red line with its +-2 sd band (sd = observed.sd_fraction
-of the value, as in the likelihood).
+predictions (blue), the measured value as a red line with its +-2 sd band: the likelihood's nominal
+observation sd, observed.sd_fraction of the value and the record's read-out sd (`readout_sd_<feature>`
+of the observed table, 0 without it) in quadrature (lambda_y = 1).
 """
 
 from __future__ import annotations
@@ -39,11 +40,18 @@ def observed_row(observed: pd.DataFrame | None, shot: str) -> pd.Series | None:
     return None if rows.empty else rows.iloc[0]
 
 
-def _panel(ax, column, training, predicted, measured, sd_fraction):
+def observation_sd(measured: pd.Series, column: str, sd_fraction: float) -> float:
+    """The nominal observation sd (m/s) of a measured feature, as the likelihood takes it at lambda_y = 1:
+    `sd_fraction` of the value and the row's read-out sd `readout_sd_<column>` (0 if absent) in quadrature."""
+    readout = pd.to_numeric(measured.get(f"readout_sd_{column}", 0.0), errors="coerce")
+    return float(np.hypot(sd_fraction * abs(float(measured[column])), readout if np.isfinite(readout) else 0.0))
+
+
+def _panel(ax, column, training, predicted, measured, sd):
     finite = [t[column].dropna().to_numpy(float) for t in (training, predicted) if t is not None and column in t.columns]
     finite = [v for v in finite if v.size]
     if measured is not None:
-        finite.append(np.array([measured * (1 - 3 * sd_fraction), measured * (1 + 3 * sd_fraction)]))
+        finite.append(np.array([measured - 3 * sd, measured + 3 * sd]))
     if not finite:
         no_data(ax, f"no {column} values")
         return
@@ -58,7 +66,6 @@ def _panel(ax, column, training, predicted, measured, sd_fraction):
         ax.hist(values, bins=bins, density=True, histtype="step", color=COLORS["posterior"], lw=1.5,
                 label="posterior predictions")
     if measured is not None:
-        sd = sd_fraction * abs(measured)
         ax.axvspan(measured - 2 * sd, measured + 2 * sd, color=COLORS["measurement"], alpha=0.15, lw=0)
         ax.axvline(measured, color=COLORS["measurement"], lw=1.8, label="measured ± 2 sd")
     ax.set_yticks([])
@@ -77,7 +84,8 @@ def feature_space(training: dict, predicted: dict, observed: pd.DataFrame | None
         measured = observed_row(observed, shot)
         for c, column in enumerate(cols):
             value = None if measured is None or column not in measured else float(measured[column])
-            _panel(axes[r, c], column, train, pred, value, sd_fraction)
+            sd = None if value is None else observation_sd(measured, column, sd_fraction)
+            _panel(axes[r, c], column, train, pred, value, sd)
         axes[r, 0].set_ylabel(shot, fontsize=10, fontweight="bold")
         missing = [what for what, table in (("training runs", train), (f"predictions ({source})", pred),
                                             ("measurement", measured)) if table is None or len(table) == 0]

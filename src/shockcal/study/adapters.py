@@ -101,22 +101,23 @@ def candidate(config: dict, name: str) -> Candidate:
 def candidate_box(config: dict, name: str) -> InputBox:
     """The box a candidate's design lies in: the prior box of the Johnson-Cook inputs, and the
     candidate's velocity (cm/us, within the velocity error's range) and shear modulus (Mbar, the
-    reference shot's box scaled by the thermal slopes' range)."""
+    reference shot's box plus the range of its thermal increment, `shear_modulus_increment_box_Mbar`:
+    it holds both the ranking's draws, G_ref (1 + s dT), and the next-shot check's training runs, whose
+    increment is an input of its own)."""
     from shockcal.candidates import SHEAR_MODULUS, VELOCITY
     from shockcal.hydro import JOHNSON_COOK_INPUTS
-    from shockcal.study.config import shear_modulus_box_Mbar
+    from shockcal.study.config import shear_modulus_box_Mbar, shear_modulus_increment_box_Mbar
     from shockcal.units import CM_US_TO_M_S
 
     shot = candidate(config, name)
     section = config["next_shot"]
     spread = 3.0**0.5 * section["velocity_sd_fraction"]
     velocity = shot.velocity_m_s / CM_US_TO_M_S
-    heating = 0.0 if shot.initial_temperature_K is None else shot.initial_temperature_K - config["material"]["T_ref_K"]
-    factors = [1.0 + section["shear_modulus_log_slope_per_K"][end] * heating for end in ("min", "max")]
     g_box = shear_modulus_box_Mbar(config, config["next_shot"]["candidates"][name]["shot"]) or (0.0, float("inf"))
+    increment = shear_modulus_increment_box_Mbar(config, name) or (0.0, 0.0)
     bounds = {**{k: v for k, v in prior_bounds(config).items() if k in JOHNSON_COOK_INPUTS},
               VELOCITY: (velocity * (1 - spread), velocity * (1 + spread)),
-              SHEAR_MODULUS: (g_box[0] * min(factors), g_box[1] * max(factors))}
+              SHEAR_MODULUS: (g_box[0] + increment[0], g_box[1] + increment[1])}
     units = {**{k: config["inputs"][k]["unit"] for k in JOHNSON_COOK_INPUTS}, VELOCITY: "cm/us", SHEAR_MODULUS: "Mbar"}
     return InputBox(bounds, units, {VELOCITY: name}, config["checks"]["design_box"])
 
@@ -233,10 +234,13 @@ def observed_table(config: dict) -> pd.DataFrame:
     InputError naming the shot and the record."""
     import pandas as pd
 
+    from shockcal.errors import ConfigError
     from shockcal.features import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS, record_features
     from shockcal.plausibility import check_plateau
 
     observed = config["observed"]
+    if observed["source"] == "synthetic":
+        raise ConfigError("observed.source is 'synthetic': this study has no measured features")
     replicates = observed["readout_replicates"] if observed["readout_error"] else 0
     rows = []
     for shot in config["shots"]:      # the config's validation checked that every shot has its source's entry

@@ -69,6 +69,22 @@ def shear_modulus_box_Mbar(config: dict, shot: str) -> tuple[float, float] | Non
                      for name, unit in zip(names, units)) for end in ("min", "max"))
 
 
+def shear_modulus_increment_box_Mbar(config: dict, name: str) -> tuple[float, float] | None:
+    """The range (Mbar) of next-shot candidate `name`'s shear modulus over its reference shot's,
+    G_ref s (T0 - T_ref), for G_ref in the reference shot's box (`shear_modulus_box_Mbar`) and s in
+    next_shot.shear_modulus_log_slope_per_K: (0, 0) at the reference temperature; None when the
+    reference shot's box is in a unit shockcal cannot convert."""
+    spec = config["next_shot"]["candidates"][name]
+    box = shear_modulus_box_Mbar(config, spec["shot"])
+    if box is None:
+        return None
+    temperature = spec.get("initial_temperature_K")
+    heating = 0.0 if temperature is None else temperature - config["material"]["T_ref_K"]
+    slopes = config["next_shot"]["shear_modulus_log_slope_per_K"]
+    ends = [g * slopes[end] * heating for g in box for end in ("min", "max")]
+    return min(ends), max(ends)
+
+
 def plateau_us(config: dict, flyer_mm: float, target_mm: float, shear_modulus_Mbar: float) -> float:
     """Time from the first arrival to the release's arrival at the free surface (us) of a symmetric
     impact of the config's material (`shockcal.plausibility.release_times_us`)."""

@@ -70,7 +70,15 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "next_shot_simulate": ("hydro", *_CANDIDATE_BOX, *_CANDIDATE),
     "next_shot_features": ("features", *_CANDIDATE),
     # the candidates' information gains and their ranking
-    "suggest_shot": ("study.seed", "next_shot", "observed.sd_fraction", "inputs", "material.T_ref_K", "strength.model?"),
+    "suggest_shot": ("study.seed", "next_shot.candidates", "next_shot.targets", "next_shot.emulator_error",
+                     "next_shot.readout_sd_m_s", "observed.sd_fraction", "inputs", "material.T_ref_K", "strength.model?"),
+    # the next-shot check's truths: joint-posterior draws with each compared candidate's inputs
+    "next_shot_check_truths": ("study.seed", "next_shot.candidates", "next_shot.check.n_truths",
+                               "next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K",
+                               "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
+                               "shots.*.analysis", "inputs", "material"),
+    # the next-shot check's realized gains and sds against the ranking
+    "next_shot_check_summary": ("next_shot.targets", "inputs", "strength.model?"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
     "figures": ("figures",),
 }

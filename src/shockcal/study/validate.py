@@ -16,7 +16,7 @@ import yaml
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
-from shockcal.study.adapters import load_study_design
+from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
 from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
@@ -178,7 +178,7 @@ def check_semantics(config: dict, source: str = "config") -> None:
         check_window(config, shot, source)
     check_next_shot(config, source)
     source_section = "records" if observed["source"] == "records" else "features"
-    for shot in config["shots"]:
+    for shot in config["shots"] if observed["source"] != "synthetic" else []:
         if shot not in observed[source_section]:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
@@ -241,6 +241,10 @@ def check_next_shot(config: dict, source: str = "config") -> None:
             if feature not in CALIBRATION_FEATURES:
                 raise ConfigError(f"{source}: next_shot.readout_sd_m_s.{feature}: not a calibration feature "
                                   f"{list(CALIBRATION_FEATURES)}")
+    for name in section["check"]["candidates"] or []:
+        if name not in section["candidates"]:
+            raise ConfigError(f"{source}: next_shot.check.candidates: unknown candidate '{name}'; next_shot.candidates "
+                              f"are {sorted(section['candidates'])}")
     for name, spec in section["candidates"].items():
         where = f"{source}: next_shot.candidates.{name}"
         if name in config["shots"]:
@@ -323,11 +327,12 @@ def check_window_fits(config: dict, spec: dict, g_max_Mbar: float, where: str) -
 
 def check_design_file(config: dict, source: str = "config") -> None:
     """The config's design file (`design.file`), if any, read and checked as every stage will read it
-    (finite, inside the prior box, ...), so that a bad file stops the config's load with its row."""
+    (finite, inside the prior box, ...; `study_design`: an input only a shot outside design.base_shots
+    reads may be missing, it is drawn), so that a bad file stops the config's load with its row."""
     design_file = config["design"].get("file")
     if not design_file:
         return
     try:
-        load_study_design(design_file, config)
+        study_design(config)
     except InputError as exc:
         raise ConfigError(f"{source}: design.file: {exc}") from None
