@@ -32,6 +32,10 @@ def evidence_figure(table: pd.DataFrame):
     values = np.concatenate([values[np.isfinite(values)], table["log_z"] + 2 * table["log_z_sd"],
                              table["log_z"] - 2 * table["log_z_sd"]])
     ax.set_xlim(values.min() - 1.5, values.max() + 1.5)      # a wider sd bar is cut at the axes
+    for row_y, half in zip(y, table["log_z_box_half"]):
+        if half == -np.inf:
+            ax.annotate("box halved: no posterior draw inside (-inf)", (0.01, row_y - 0.2), xycoords=("axes fraction", "data"),
+                        va="center", fontsize=7, color=COLORS["model"])
     ax.set_xlabel("log evidence")
     ax.set_title("log Z per law; with the box of its own and shear-modulus parameters\nhalved and doubled "
                  "about its centre (bars cut at the axes)")
