@@ -58,8 +58,8 @@ def test_half_box_sd_matches_the_spread_over_seeds():
 def test_half_box_adds_log_z_sd_in_quadrature_and_warns_when_empty(caplog):
     points = np.array([[1.1, 0.1], [2.9, 1.9]])                      # both outside the half box
     draws = WeightedDraws(points, np.log([0.5, 0.5]), np.zeros(2), -10.0, 2, 0.1)
-    assert half_box(draws, LOWER, UPPER)[:2] == (-math.inf, pytest.approx(math.nan, nan_ok=True))
-    assert "no posterior draw inside the half box" in caplog.text and "Kish ESS 2" in caplog.text
+    assert half_box(draws, LOWER, UPPER, "ptw")[:2] == (-math.inf, pytest.approx(math.nan, nan_ok=True))
+    assert "ptw: no posterior draw inside the half box" in caplog.text and "Kish ESS 2" in caplog.text
     inside = WeightedDraws(np.array([[2.0, 1.0], [2.9, 1.9]]), np.log([0.5, 0.5]), np.zeros(2), -10.0, 2, 0.1)
     log_z_half, sd, mass = half_box(inside, LOWER, UPPER)
     assert mass == 0.5 and log_z_half == pytest.approx(-10.0 + 2 * math.log(2) + math.log(0.5))

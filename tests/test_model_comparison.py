@@ -94,3 +94,8 @@ def test_command_reads_each_study(tmp_path):
                              "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
     assert no_box.returncode != 0 and "Traceback" not in no_box.stderr
     assert "--model zerilli-armstrong:" in no_box.stderr and "input_bounds has no a" in no_box.stderr
+    (za / "emulator" / "emulator.json").write_text("{not json")
+    damaged = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
+                              "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
+    assert damaged.returncode != 0 and "Traceback" not in damaged.stderr
+    assert "emulator.json: not an emulator's JSON description" in damaged.stderr

@@ -50,10 +50,11 @@ def physical_floor(lower: np.ndarray) -> np.ndarray:
     return np.where(lower >= 0.0, 0.0, -np.inf)
 
 
-def half_box(draws: WeightedDraws, lower: np.ndarray, upper: np.ndarray) -> tuple[float, float, float]:
+def half_box(draws: WeightedDraws, lower: np.ndarray, upper: np.ndarray, label: str = "posterior"
+             ) -> tuple[float, float, float]:
     """(log Z_half, its sd, P_half) for the box [lower, upper] of `draws.points`' columns (k = their number)
-    halved about its centre. P_half = 0 in the draws gives -inf and NaN, with one warning line giving the
-    upper bound from the Kish ESS (P_half < 3 / ESS, 95%)."""
+    halved about its centre. P_half = 0 in the draws gives -inf and NaN, with one warning line naming `label`
+    and giving the upper bound from the Kish ESS (P_half < 3 / ESS, 95%)."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     centre, quarter = (lower + upper) / 2, (upper - lower) / 4
     inside = np.all(np.abs(draws.points - centre) <= quarter, axis=1)
@@ -62,8 +63,8 @@ def half_box(draws: WeightedDraws, lower: np.ndarray, upper: np.ndarray) -> tupl
     k = len(lower)
     if mass <= 0.0:
         bound = draws.log_evidence + k * math.log(2) + math.log(min(3.0 / ess, 1.0))
-        log.warning("no posterior draw inside the half box: log Z_half = -inf (< %.2f at 95%% from Kish ESS %.0f)",
-                    bound, ess)
+        log.warning("%s: no posterior draw inside the half box: log Z_half = -inf (< %.2f at 95%% from Kish ESS %.0f)",
+                    label, bound, ess)
         return -math.inf, math.nan, 0.0
     mass_sd_log = math.sqrt(np.sum(draws.weights**2 * (inside - mass) ** 2)) / mass
     return (draws.log_evidence + k * math.log(2) + math.log(mass),
@@ -95,10 +96,11 @@ def mass_near_moved_faces(draws: WeightedDraws, lower: np.ndarray, upper: np.nda
     return float(np.sum(draws.weights[near]))
 
 
-def box_sensitivity(draws: WeightedDraws, lower: np.ndarray, upper: np.ndarray) -> BoxSensitivity:
+def box_sensitivity(draws: WeightedDraws, lower: np.ndarray, upper: np.ndarray, label: str = "posterior"
+                    ) -> BoxSensitivity:
     """The evidence's sensitivity to the box [lower, upper] (user units of `draws.points`' k columns, which
-    are the box parameters only); the floors are `physical_floor(lower)`."""
+    are the box parameters only); the floors are `physical_floor(lower)`; `label` names the run in warnings."""
     floor = physical_floor(lower)
-    log_z_half, sd, _ = half_box(draws, lower, upper)
+    log_z_half, sd, _ = half_box(draws, lower, upper, label)
     return BoxSensitivity(len(lower), log_z_half, sd, double_box_log_z(draws.log_evidence, lower, upper, floor),
                           mass_near_moved_faces(draws, lower, upper, floor))

@@ -88,7 +88,10 @@ def box_result(name: str, weighted_path, emulator_path):
     names = [p for p in meta["parameters"] if meta["units"].get(p) != VELOCITY_UNIT]
     table = read_table(weighted_path)
     require_columns(table, [*names, "log_weight", "log_likelihood"], weighted_path)
-    bounds = json.loads(Path(emulator_path).read_text()).get("input_bounds", {})
+    try:
+        bounds = json.loads(Path(emulator_path).read_text()).get("input_bounds", {})
+    except (ValueError, AttributeError):
+        raise InputError(f"--model {name}: {emulator_path}: not an emulator's JSON description") from None
     missing = [p for p in names if p not in bounds]
     if missing:
         raise InputError(f"--model {name}: {emulator_path}: input_bounds has no {', '.join(missing)}")
@@ -96,7 +99,7 @@ def box_result(name: str, weighted_path, emulator_path):
     draws = WeightedDraws(table[names].to_numpy(float), table["log_weight"].to_numpy(float),
                           table["log_likelihood"].to_numpy(float), float(meta["log_evidence"]), 0,
                           float(meta["log_evidence_sd"]))
-    return box_sensitivity(draws, lower, upper)
+    return box_sensitivity(draws, lower, upper, name)
 
 
 def run(args) -> int:
