@@ -55,7 +55,7 @@ def test_models_quick_is_the_paper_config_with_the_quick_overlay(tmp_path):
     assert "results/models-quick/evidence.csv" in printed and "results/models-quick/release.csv" in printed
 
 
-@pytest.mark.slow   # two quick studies with their predictive runs: 9.8 min on 2 cores at load 6-10 (2026-11-26)
+@pytest.mark.slow   # two quick studies with their predictive runs: 6.3 min on 2 cores at load 3-6 (2026-11-26)
 def test_models_at_toy_size_end_to_end(tmp_path):
     """`make models` as models-quick runs it, for Johnson-Cook and Steinberg-Guinan (a law with its own G law and
     no per-shot modulus inputs): evidence.csv with the box columns, release.csv per law and shot, the figures."""
