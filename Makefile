@@ -10,7 +10,7 @@ LOCKED_PYTHON := 3.11
 CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick models models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: study quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 $(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -27,20 +27,28 @@ study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
 	snakemake --cores $(CORES) all --configfile config/quick.yaml
 
-# the strength laws compared by `make models` (docs/strength_laws.md): one study each, to its joint posterior
+# the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
+# posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files
+# in order, the paper's config/config.yaml first (compare-models and model-predictions read the shots and records from it)
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml
 MODELS_DIR ?= results/models
 
-models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then results/models/evidence.csv
+models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
 	for model in $(MODELS); do \
 	  snakemake --cores $(CORES) --configfile $(MODELS_CONFIG) --config "strength={model: $$model}" \
-	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.parquet || exit 1; \
+	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.nc || exit 1; \
 	done
-	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv
+	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
+	  --figures-dir $(MODELS_DIR)/figures
+	shockcal model-predictions --config $(firstword $(MODELS_CONFIG)) $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) \
+	  --out $(MODELS_DIR)/release.csv --figures-dir $(MODELS_DIR)/figures
+
+models-reduced: $(INSTALLED)  ## the same at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
+	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
 
 models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into results/models-quick
-	$(MAKE) models MODELS_CONFIG=config/quick.yaml MODELS_DIR=results/models-quick
+	$(MAKE) models MODELS_CONFIG="config/config.yaml config/quick.yaml" MODELS_DIR=results/models-quick
 
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
 	snakemake --cores $(CORES) check

@@ -2,24 +2,28 @@
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
 import sys
 
+import numpy as np
 import pandas as pd
 import pytest
 
+from shockcal.box_sensitivity import BoxSensitivity
 from shockcal.errors import InputError
 from shockcal.io import write_table
 from shockcal.model_comparison import COLUMNS, ModelResult, evidence_table
 
 OBSERVED = (69.7, 199.4, 79.5, 186.4)
+BOX = BoxSensitivity(2, -46.0, 0.1, -47.5, 0.2)
 
 
 def test_bayes_factors_against_johnson_cook():
     table = evidence_table({
-        "johnson-cook": ModelResult(("A", "B"), -45.0, 0.03, OBSERVED, 12.0, 20.0),
-        "steinberg-guinan": ModelResult(("Y0_GPa", "n", "V1"), -43.5, 0.04, OBSERVED, 10.0, 15.0),
+        "johnson-cook": ModelResult(("A", "B"), -45.0, 0.03, OBSERVED, 12.0, 20.0, BOX),
+        "steinberg-guinan": ModelResult(("Y0_GPa", "n", "V1"), -43.5, 0.04, OBSERVED, 10.0, 15.0, BOX),
     })
     assert list(table.columns) == COLUMNS
     sg = table.set_index("model").loc["steinberg-guinan"]
@@ -27,22 +31,30 @@ def test_bayes_factors_against_johnson_cook():
     assert sg["log_bf_sd"] == pytest.approx(0.05)                       # 0.03 and 0.04 in quadrature
     assert sg["n_params"] == 3
     assert table.set_index("model").loc["johnson-cook", "log_bf_vs_johnson_cook"] == 0.0
+    assert (sg["n_box_params"], sg["log_z_box_half"], sg["log_z_box_half_sd"], sg["log_z_box_double"],
+            sg["posterior_mass_near_faces"]) == tuple(BOX)
 
 
 def test_evidences_of_other_data_do_not_compare():
     with pytest.raises(InputError, match="ptw was calibrated on other measured features"):
-        evidence_table({"johnson-cook": ModelResult(("A",), -45.0, 0.03, OBSERVED, 12.0, 20.0),
-                        "ptw": ModelResult(("s0",), -40.0, 0.03, (*OBSERVED[:3], 187.0), 12.0, 20.0)})
+        evidence_table({"johnson-cook": ModelResult(("A",), -45.0, 0.03, OBSERVED, 12.0, 20.0, BOX),
+                        "ptw": ModelResult(("s0",), -40.0, 0.03, (*OBSERVED[:3], 187.0), 12.0, 20.0, BOX)})
     with pytest.raises(InputError, match="no johnson-cook study"):
-        evidence_table({"ptw": ModelResult(("s0",), -40.0, 0.03, OBSERVED, 12.0, 20.0)})
+        evidence_table({"ptw": ModelResult(("s0",), -40.0, 0.03, OBSERVED, 12.0, 20.0, BOX)})
 
 
 def _study(tmp_path, name, log_z, sd, kfold, outer=None):
+    """A study's files as compare-models reads them: inputs a (Mbar, box [0, 2]) and the velocity V1 (cm/us),
+    four weighted draws, one inside a's half box [0.5, 1.5] with weight 0.4."""
     root = tmp_path / name
-    write_table(pd.DataFrame({"x": [0.0]}), root / "posterior" / "joint.parquet",
-                {"table": "posterior samples", "parameters": ["a", "b"], "log_evidence": log_z,
-                 "log_evidence_sd": sd, "observed": str(list(OBSERVED))})
+    meta = {"parameters": ["V1", "a"], "log_evidence": log_z, "log_evidence_sd": sd, "observed": str(list(OBSERVED)),
+            "units": {"a": "Mbar", "V1": "cm/us", "lambda_y": "-"}}
+    write_table(pd.DataFrame({"x": [0.0]}), root / "posterior" / "joint.parquet", {"table": "posterior samples", **meta})
+    write_table(pd.DataFrame({"V1": [0.02] * 4, "a": [0.05, 1.0, 1.6, 1.95], "lambda_y": 1.0,
+                              "log_weight": np.log([0.1, 0.4, 0.2, 0.3]), "log_likelihood": 0.0}),
+                root / "posterior" / "joint_weighted.parquet", {"table": "posterior weighted draws", **meta})
     (root / "emulator").mkdir(parents=True)
+    (root / "emulator" / "emulator.json").write_text(json.dumps({"input_bounds": {"a": [0.0, 2.0], "V1": [0.01, 0.03]}}))
     (root / "emulator" / "cv_rmse.csv").write_text(
         "scheme,shot,feature,rmse_m_s,bias_m_s,coverage90\n"
         f"kfold,104S,v_elastic,99,0,0.9\nkfold,all,all,{kfold},0,0.9\n"
@@ -56,10 +68,18 @@ def test_command_reads_each_study(tmp_path):
     ptw = _study(tmp_path, "ptw", -46.0, 0.05, 30.0)                   # no outer check: too few runs inside
     out = tmp_path / "models" / "evidence.csv"
     done = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
-                           "--model", f"zerilli-armstrong={za}", "--model", f"ptw={ptw}", "--out", str(out)],
-                          capture_output=True, text=True)
+                           "--model", f"zerilli-armstrong={za}", "--model", f"ptw={ptw}", "--out", str(out),
+                           "--figures-dir", str(tmp_path / "models" / "figures")], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+    assert (tmp_path / "models" / "figures" / "evidence.png").is_file()
     table = pd.read_csv(out).set_index("model")
+    za_row = table.loc["zerilli-armstrong"]
+    assert za_row["n_box_params"] == 1                                  # a; V1 (cm/us) is a shot's velocity
+    assert za_row["log_z_box_half"] == pytest.approx(-47.0 + math.log(2) + math.log(0.4))
+    assert za_row["log_z_box_half_sd"] == pytest.approx(math.hypot(0.04, math.sqrt(
+        0.1**2 * 0.4**2 + 0.4**2 * 0.6**2 + 0.2**2 * 0.4**2 + 0.3**2 * 0.4**2) / 0.4))
+    assert za_row["log_z_box_double"] == pytest.approx(-47.0 - math.log(3 / 2))   # [0, 2] -> [0, 3]: clipped at 0
+    assert za_row["posterior_mass_near_faces"] == pytest.approx(0.3)               # a = 1.95 > 1.9; 0.05 is near a face at its floor
     assert table.loc["zerilli-armstrong", "log_bf_vs_johnson_cook"] == pytest.approx(-2.0)
     assert table.loc["zerilli-armstrong", "kfold_rmse_m_s"] == 11.0
     assert table.loc["zerilli-armstrong", "log_bf_sd"] == pytest.approx(math.hypot(0.03, 0.04))
@@ -69,3 +89,13 @@ def test_command_reads_each_study(tmp_path):
     assert missing.returncode != 0
     assert "--model ptw:" in missing.stderr and "joint.parquet does not exist" in missing.stderr
     assert "Traceback" not in missing.stderr
+    (za / "emulator" / "emulator.json").write_text(json.dumps({"input_bounds": {"V1": [0.01, 0.03]}}))
+    no_box = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
+                             "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
+    assert no_box.returncode != 0 and "Traceback" not in no_box.stderr
+    assert "--model zerilli-armstrong:" in no_box.stderr and "input_bounds has no a" in no_box.stderr
+    (za / "emulator" / "emulator.json").write_text("{not json")
+    damaged = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
+                              "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
+    assert damaged.returncode != 0 and "Traceback" not in damaged.stderr
+    assert "emulator.json: not an emulator's JSON description" in damaged.stderr

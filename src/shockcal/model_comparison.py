@@ -1,12 +1,14 @@
 """Strength laws compared by their evidence: one row per law from its joint posterior and its emulator's
 held-out errors (issue 37). The table's columns:
 
-    model, n_params, log_z, log_z_sd, log_bf_vs_johnson_cook, log_bf_sd, kfold_rmse_m_s, outer_rmse_m_s
+    model, n_params, log_z, log_z_sd, log_bf_vs_johnson_cook, log_bf_sd, n_box_params, log_z_box_half,
+    log_z_box_half_sd, log_z_box_double, posterior_mass_near_faces, kfold_rmse_m_s, outer_rmse_m_s
 
 log_bf_vs_johnson_cook = log Z - log Z(johnson-cook), its sd the two sds in quadrature (independent
 runs). log_z_sd is nautilus's importance-sampling estimate (`Posterior.log_evidence_sd`), a lower bound
-of the Monte Carlo spread. Not here yet: the evidence with each box halved and doubled about its centre
-(log_z_box_half, log_z_box_double), which needs two more calibrations per law.
+of the Monte Carlo spread. The box columns (`shockcal.box_sensitivity`): the evidence with the box of the
+law's own and shear-modulus parameters halved (exact, with its sd) and doubled (a lower bound) about its
+centre, from the same run's weighted draws, and the posterior mass near the faces the doubled box moves.
 """
 
 from __future__ import annotations
@@ -17,17 +19,19 @@ from typing import NamedTuple
 
 import pandas as pd
 
+from shockcal.box_sensitivity import BoxSensitivity
 from shockcal.errors import InputError
 
 REFERENCE_MODEL = "johnson-cook"
-COLUMNS = ["model", "n_params", "log_z", "log_z_sd", "log_bf_vs_johnson_cook", "log_bf_sd", "kfold_rmse_m_s",
+COLUMNS = ["model", "n_params", "log_z", "log_z_sd", "log_bf_vs_johnson_cook", "log_bf_sd", "n_box_params",
+           "log_z_box_half", "log_z_box_half_sd", "log_z_box_double", "posterior_mass_near_faces", "kfold_rmse_m_s",
            "outer_rmse_m_s"]
 
 
 class ModelResult(NamedTuple):
     """One law's study: its joint posterior's calibrated inputs, log evidence and sd, the measured
-    features it was calibrated on (m/s), and its emulator's K-fold and outer-check RMSE over all shots
-    and features (m/s)."""
+    features it was calibrated on (m/s), its emulator's K-fold and outer-check RMSE over all shots
+    and features (m/s), and the evidence's sensitivity to its box."""
 
     parameters: tuple[str, ...]
     log_z: float
@@ -35,6 +39,7 @@ class ModelResult(NamedTuple):
     observed_m_s: tuple[float, ...]
     kfold_rmse_m_s: float
     outer_rmse_m_s: float
+    box: BoxSensitivity
 
 
 def evidence_table(results: Mapping[str, ModelResult]) -> pd.DataFrame:
@@ -53,5 +58,8 @@ def evidence_table(results: Mapping[str, ModelResult]) -> pd.DataFrame:
         rows.append({"model": model, "n_params": len(result.parameters), "log_z": result.log_z,
                      "log_z_sd": result.log_z_sd, "log_bf_vs_johnson_cook": result.log_z - reference.log_z,
                      "log_bf_sd": 0.0 if model == REFERENCE_MODEL else math.hypot(result.log_z_sd, reference.log_z_sd),
+                     "n_box_params": result.box.k, "log_z_box_half": result.box.log_z_half,
+                     "log_z_box_half_sd": result.box.log_z_half_sd, "log_z_box_double": result.box.log_z_double,
+                     "posterior_mass_near_faces": result.box.mass_near_faces,
                      "kfold_rmse_m_s": result.kfold_rmse_m_s, "outer_rmse_m_s": result.outer_rmse_m_s})
     return pd.DataFrame(rows, columns=COLUMNS)

@@ -34,6 +34,7 @@ STAGE_MODULES = [
     "shockcal.cli.config_doc",
     "shockcal.cli.flow_stress",
     "shockcal.cli.compare_models",
+    "shockcal.cli.model_predictions",
 ]
 
 

@@ -1,9 +1,16 @@
 """`shockcal compare-models`: the strength laws' evidence table from each law's study.
 
 Reads, per `--model NAME=RESULTS_DIR`: RESULTS_DIR/posterior/joint.parquet's metadata (calibrated inputs,
-log evidence and its sd, the measured features) and RESULTS_DIR/emulator/cv_rmse.csv (the K-fold and
-outer check's RMSE over all shots and features; the outer one empty when the emulator skipped it).
-Writes `--out` (CSV; shockcal.model_comparison.COLUMNS).
+log evidence and its sd, the measured features), RESULTS_DIR/posterior/joint_weighted.parquet (the
+sampler's weighted draws, for the box sensitivity), RESULTS_DIR/emulator/emulator.json's input_bounds
+(the prior box the calibration used) and RESULTS_DIR/emulator/cv_rmse.csv (the K-fold and outer check's
+RMSE over all shots and features; the outer one empty when the emulator skipped it).
+Writes `--out` (CSV; shockcal.model_comparison.COLUMNS) and, with `--figures-dir`, the log evidence per law
+(evidence.png and .pdf).
+
+The box parameters are the calibrated inputs except the shots' impact velocities (the inputs in cm/us,
+the unit the config schema gives a shot's velocity_input: measured shot properties with their own error)
+and lambda_y (the error scale, not an input): the law's own parameters and its shear-modulus inputs.
 """
 
 from __future__ import annotations
@@ -15,6 +22,8 @@ def register(subparsers) -> None:
     p.add_argument("--model", action="append", required=True, metavar="NAME=RESULTS_DIR",
                    help="a law and its study's results_dir (repeat; johnson-cook required)")
     p.add_argument("--out", required=True, help="the table (CSV), e.g. results/models/evidence.csv")
+    p.add_argument("--figures-dir", default=None, help="where evidence.png and .pdf go (log Z per law with +-2 sd and "
+                   "the box-halved and -doubled values), e.g. results/models/figures")
     p.set_defaults(func=run)
 
 
@@ -32,8 +41,10 @@ def model_result(name: str, results_dir: str):
     from shockcal.model_comparison import ModelResult
 
     posterior = Path(results_dir) / "posterior" / "joint.parquet"
+    weighted = Path(results_dir) / "posterior" / "joint_weighted.parquet"
+    emulator = Path(results_dir) / "emulator" / "emulator.json"
     cv = Path(results_dir) / "emulator" / "cv_rmse.csv"
-    for path in (posterior, cv):
+    for path in (posterior, weighted, emulator, cv):
         if not path.is_file():
             raise InputError(f"--model {name}: {path} does not exist (run the law's study to its joint posterior)")
     meta = read_table_metadata(posterior)
@@ -50,7 +61,45 @@ def model_result(name: str, results_dir: str):
     observed = meta["observed"]
     observed = [float(v) for v in (observed.strip("[]").split(",") if isinstance(observed, str) else observed)]
     return ModelResult(tuple(meta["parameters"]), float(meta["log_evidence"]), float(meta["log_evidence_sd"]),
-                       tuple(observed), float(overall["kfold"]), float(overall.get("outer", math.nan)))
+                       tuple(observed), float(overall["kfold"]), float(overall.get("outer", math.nan)),
+                       box_result(name, weighted, emulator))
+
+
+VELOCITY_UNIT = "cm/us"      # a shot's velocity_input (config schema): excluded from the box
+
+
+def box_result(name: str, weighted_path, emulator_path):
+    """The evidence's sensitivity to the box of one law's study (`shockcal.box_sensitivity`) from its weighted
+    draws and its emulator's input bounds; InputError naming the file and key that is missing."""
+    import json
+    from pathlib import Path
+
+    import numpy as np
+
+    from shockcal.box_sensitivity import box_sensitivity
+    from shockcal.errors import InputError
+    from shockcal.io import read_table, read_table_metadata, require_columns
+    from shockcal.sampler import WeightedDraws
+
+    meta = read_table_metadata(weighted_path)
+    for key in ("parameters", "units", "log_evidence", "log_evidence_sd"):
+        if key not in meta:
+            raise InputError(f"--model {name}: {weighted_path}: metadata has no {key}")
+    names = [p for p in meta["parameters"] if meta["units"].get(p) != VELOCITY_UNIT]
+    table = read_table(weighted_path)
+    require_columns(table, [*names, "log_weight", "log_likelihood"], weighted_path)
+    try:
+        bounds = json.loads(Path(emulator_path).read_text()).get("input_bounds", {})
+    except (ValueError, AttributeError):
+        raise InputError(f"--model {name}: {emulator_path}: not an emulator's JSON description") from None
+    missing = [p for p in names if p not in bounds]
+    if missing:
+        raise InputError(f"--model {name}: {emulator_path}: input_bounds has no {', '.join(missing)}")
+    lower, upper = (np.array([bounds[p][i] for p in names], dtype=float) for i in (0, 1))
+    draws = WeightedDraws(table[names].to_numpy(float), table["log_weight"].to_numpy(float),
+                          table["log_likelihood"].to_numpy(float), float(meta["log_evidence"]), 0,
+                          float(meta["log_evidence_sd"]))
+    return box_sensitivity(draws, lower, upper, name)
 
 
 def run(args) -> int:
@@ -75,4 +124,9 @@ def run(args) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     table.to_csv(out, index=False, float_format="%.6g")
     logging.getLogger("shockcal.compare_models").info("wrote %s:\n%s", out, table.to_string(index=False))
+    if args.figures_dir:
+        from shockcal.plots.models import evidence_figure
+        from shockcal.plots.style import save_figure
+
+        save_figure(evidence_figure(table), Path(args.figures_dir) / "evidence")
     return 0
