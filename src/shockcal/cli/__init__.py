@@ -62,6 +62,24 @@ def parse_pairs(pairs: list[str], option: str) -> dict[str, str]:
     return parsed
 
 
+def parse_model_dirs(pairs: list[str], option: str = "--model") -> dict[str, str]:
+    """['johnson-cook=results/models/johnson-cook', ...] -> {law name: results directory}, the name
+    resolved through the law registry (aliases allowed); a malformed pair, an unknown law or a law given
+    twice is an InputError."""
+    from shockcal.hydro.laws import get_law
+
+    parsed = {}
+    for pair in pairs:
+        name, sep, results_dir = pair.partition("=")
+        if not sep or not results_dir:
+            raise InputError(f"{option}: '{pair}' is not NAME=RESULTS_DIR")
+        law = get_law(name).name
+        if law in parsed:
+            raise InputError(f"{option}: {law} given twice")
+        parsed[law] = results_dir
+    return parsed
+
+
 def unique_shots(shots: list[str], option: str = "--shots") -> list[str]:
     """The shots of a command line, each once; a shot given twice is an InputError naming it."""
     twice = sorted({shot for shot in shots if shots.count(shot) > 1})

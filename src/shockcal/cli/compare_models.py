@@ -106,19 +106,10 @@ def run(args) -> int:
     import logging
     from pathlib import Path
 
-    from shockcal.errors import InputError
-    from shockcal.hydro.laws import get_law
+    from shockcal.cli import parse_model_dirs
     from shockcal.model_comparison import evidence_table
 
-    results = {}
-    for pair in args.model:
-        name, sep, results_dir = pair.partition("=")
-        if not sep or not results_dir:
-            raise InputError(f"--model: '{pair}' is not NAME=RESULTS_DIR")
-        law = get_law(name).name
-        if law in results:
-            raise InputError(f"--model: {law} given twice")
-        results[law] = model_result(law, results_dir)
+    results = {law: model_result(law, results_dir) for law, results_dir in parse_model_dirs(args.model).items()}
     table = evidence_table(results)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -76,8 +76,8 @@ def run(args) -> int:
 
     import pandas as pd
 
+    from shockcal.cli import parse_model_dirs
     from shockcal.errors import InputError
-    from shockcal.hydro.laws import get_law
     from shockcal.release import RELEASE_COLUMNS, RELEASE_MARGIN_M_S
     from shockcal.study.validate import load_config
 
@@ -86,13 +86,7 @@ def run(args) -> int:
     if not margin > 0:
         raise InputError(f"--margin-m-s: {args.margin_m_s} must be positive (m/s)")
     rows, pages = [], {}
-    for pair in args.model:
-        name, sep, results_dir = pair.partition("=")
-        if not sep or not results_dir:
-            raise InputError(f"--model: '{pair}' is not NAME=RESULTS_DIR")
-        law = get_law(name).name
-        if law in pages:
-            raise InputError(f"--model: {law} given twice")
+    for law, results_dir in parse_model_dirs(args.model).items():
         law_rows, pages[law] = law_predictions(law, results_dir, config, margin)
         rows += law_rows
     table = pd.DataFrame(rows, columns=RELEASE_COLUMNS)
