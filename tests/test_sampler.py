@@ -89,6 +89,7 @@ def test_systematic_resampling_keeps_each_point_floor_or_ceil_of_its_share():
     assert draws.kish_ess() == pytest.approx(1 / np.sum(w**2))
 
 
+@pytest.mark.slow   # 30 s: eight nautilus runs (`make test-slow`)
 def test_evidence_sd_matches_the_spread_over_seeds_and_the_truth():
     # A 3-D Gaussian likelihood in a box, log Z known exactly: over 8 seeds the runs' log Z scatter
     # about the truth by the sd each run reports (`evidence_sd`, from nautilus's counts): the mean z^2

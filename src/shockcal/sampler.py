@@ -166,7 +166,7 @@ class SamplerSettings:
         max_evaluations: likelihood evaluations after which a run short of `n_eff` stops with an error.
     """
 
-    n_live: int = 1000
+    n_live: int = 500
     n_eff: int = 3000
     draws: int = 10000
     seed: int = 0
