@@ -17,7 +17,8 @@ from shockcal.candidates import SHEAR_MODULUS, VELOCITY
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import AL5083
-from shockcal.next_shot_check import check_summary, check_table, normal_scores, realized_gain, truth_design, verdict
+from shockcal.next_shot import normal_scores
+from shockcal.next_shot_check import check_summary, check_table, realized_gain, truth_design, verdict
 from shockcal.study.adapters import candidate, candidate_box, input_box, shot_mapping, study_design
 from shockcal.study.config import input_names, prior_bounds
 from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config

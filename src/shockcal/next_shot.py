@@ -194,7 +194,7 @@ def expected_information_gain(features, noise_sd, rng: np.random.Generator, targ
     if cols is None or len(cols) == th.shape[1]:
         eig, eig_sd, method = full, full_sd, "nmc-loo"
     else:
-        z = _scores(th[:, cols])
+        z = normal_scores(th[:, cols], th[:, cols])
         eig = float(np.mean(_entropy_bound_terms(z, weights)))
         boot = [np.sum(c[draw] * _entropy_bound_terms(z, _weights(log_lik, other, c))) / np.sum(c[draw])
                 for c in counts]
@@ -257,9 +257,20 @@ def _nmc(log_lik, own, other, draw, counts) -> tuple[float, np.ndarray]:
     return estimate, boot
 
 
-def _scores(x: np.ndarray) -> np.ndarray:
-    """Rank normal scores of each column: Phi^-1((rank - 1/2) / n), ties averaged."""
-    return stats.norm.ppf((stats.rankdata(x, axis=0) - 0.5) / len(x))
+def normal_scores(reference: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Normal scores of `values` (M, d) by the marginal empirical CDFs of `reference` (N, d):
+    Phi^-1(F(x)), F the mid-rank CDF (a value equal to k reference draws sits in the middle of them),
+    clipped to [1/(2N), 1 - 1/(2N)]: the reference's own scores are rank normal scores."""
+    reference, values = np.atleast_2d(reference), np.atleast_2d(values)
+    n = len(reference)
+    scores = np.empty(values.shape)
+    for j in range(reference.shape[1]):
+        ordered = np.sort(reference[:, j])
+        below = np.searchsorted(ordered, values[:, j], side="left")
+        upto = np.searchsorted(ordered, values[:, j], side="right")
+        cdf = np.clip(0.5 * (below + upto) / n, 0.5 / n, 1 - 0.5 / n)
+        scores[:, j] = stats.norm.ppf(cdf)
+    return scores
 
 
 def _weights(log_lik, other, counts=None) -> np.ndarray:

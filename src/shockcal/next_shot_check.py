@@ -23,11 +23,11 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from shockcal.candidates import SHEAR_MODULUS, VELOCITY, Candidate, candidate_design
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
+from shockcal.next_shot import normal_scores
 
 
 def truth_design(posterior: pd.DataFrame, names: Sequence[str], candidates: Mapping[str, tuple[Candidate, str, str | None]],
@@ -65,22 +65,6 @@ def truth_design(posterior: pd.DataFrame, names: Sequence[str], candidates: Mapp
         if increment_input is not None:
             truths[increment_input] = design[SHEAR_MODULUS] - design[list(candidate.shear_modulus_inputs)].sum(axis=1)
     return truths, designs
-
-
-def normal_scores(reference: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Normal scores of `values` (M, d) by the marginal empirical CDFs of `reference` (N, d):
-    Phi^-1(F(x)), F the mid-rank CDF (a value equal to k reference draws sits in the middle of them),
-    clipped to [1/(2N), 1 - 1/(2N)]: the reference's own scores are rank normal scores."""
-    reference, values = np.atleast_2d(reference), np.atleast_2d(values)
-    n = len(reference)
-    scores = np.empty(values.shape)
-    for j in range(reference.shape[1]):
-        ordered = np.sort(reference[:, j])
-        below = np.searchsorted(ordered, values[:, j], side="left")
-        upto = np.searchsorted(ordered, values[:, j], side="right")
-        cdf = np.clip(0.5 * (below + upto) / n, 0.5 / n, 1 - 0.5 / n)
-        scores[:, j] = stats.norm.ppf(cdf)
-    return scores
 
 
 def realized_gain(reference: np.ndarray, before: np.ndarray, after: np.ndarray) -> float:
