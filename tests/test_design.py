@@ -1,13 +1,20 @@
 """Design tables: the seeded Latin hypercube, user designs and the per-shot mapping."""
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
 
+from shockcal.cli import main
 from shockcal.design import chunk_fingerprints, latin_hypercube
 from shockcal.errors import InputError
+from shockcal.io import read_table
 from shockcal.study.adapters import input_box, load_study_design, shot_mapping
 from shockcal.study.config import prior_bounds
+from shockcal.study.validate import load_config
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def test_latin_hypercube_fills_the_box_one_point_per_stratum(paper_config):
@@ -142,3 +149,16 @@ def test_base_shots_must_name_shots(paper_config):
     paper_config["design"]["base_shots"] = ["104S", "108S"]
     with pytest.raises(ConfigError, match=r"design\.base_shots: '108S' is not a shot"):
         validate_config(paper_config)
+
+
+@pytest.mark.parametrize("stream", ["design", "check_design"])
+def test_the_design_commands_read_only_their_stages_keys(tmp_path, stream):
+    """`shockcal design` as the rules design and check_design run it, on the default study: each reads
+    its stage's slice of the config only (a key outside it is a KeyError), the check's design a
+    hypercube of calibration.check.trials runs over every input, its modulus increments included."""
+    config = load_config(REPO / "config" / "config.yaml")
+    out = tmp_path / "design.parquet"
+    assert main(["design", "--config", str(REPO / "config" / "config.yaml"), "--stream", stream, "--out", str(out)]) == 0
+    design = read_table(out)
+    rows = config["calibration"]["check"]["trials"] if stream == "check_design" else config["design"]["n_runs"]
+    assert len(design) == rows and list(design.columns) == ["run", *config["inputs"]]

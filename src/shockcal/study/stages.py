@@ -35,7 +35,8 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
     "design": ("study.seed", "design", "inputs", "checks.design_box", *_SHOT_MAPPING),
     # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
-    "check_design": ("study.seed", "inputs", "calibration.check.trials"),
+    "check_design": ("study.seed", "inputs", "calibration.check.trials", "design.base_shots", "checks.design_box",
+                     *_SHOT_MAPPING),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto
     "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?",
                  *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
