@@ -12,7 +12,14 @@ import pytest
 from scipy import stats
 
 from shockcal.calibration import calibrate
-from shockcal.coverage import HydroTruths, coverage_table, hpd_mass, joint_coverage, synthetic_truth
+from shockcal.coverage import (
+    HydroTruths,
+    coverage_by_fifth,
+    coverage_table,
+    hpd_mass,
+    joint_coverage,
+    synthetic_truth,
+)
 from shockcal.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.problem import Problem, log_density
@@ -161,6 +168,27 @@ def test_coverage_leaves_failed_trials_out_and_counts_them(three_toy_trials):
     assert joint_coverage(marked)["trials"] == 2
     older = trials.drop(columns=["status", "reason"]).assign(trial=trials["trial"] + 10)   # batches from before
     assert (coverage_table(pd.concat([marked, older], ignore_index=True))["trials"] == 5).all()
+
+
+def test_coverage_by_fifth_finds_the_misses_at_low_truths():
+    """100 trials, the truths of n shuffled: the intervals miss every truth below 0.15 (the lowest 10) and
+    hold the rest; A's hold everywhere but at trials 0-9, spread over its truths. Per fifth of the truths:
+    n's lowest fifth 0.50, its others 1.00; A's misses wherever its truths of trials 0-9 fall. A failed
+    trial is left out."""
+    rng = np.random.default_rng(8)
+    n_truth = rng.permutation(np.linspace(0.0, 1.5, 100))
+    a_truth = rng.uniform(size=100)
+    rows = pd.concat([pd.DataFrame({"trial": np.arange(100), "parameter": "n", "truth": n_truth,
+                                    "inside": n_truth >= 0.15, "status": "ok"}),
+                      pd.DataFrame({"trial": np.arange(100), "parameter": "A", "truth": a_truth,
+                                    "inside": np.arange(100) >= 10, "status": "ok"})], ignore_index=True)
+    failed = pd.DataFrame({"trial": [100], "parameter": ["n"], "truth": [0.0], "inside": [None], "status": ["failed"]})
+    table = coverage_by_fifth(pd.concat([rows, failed], ignore_index=True))
+    assert list(table.index) == ["n", "A"] and list(table.columns) == ["1/5", "2/5", "3/5", "4/5", "5/5"]
+    np.testing.assert_allclose(table.loc["n"], [0.5, 1.0, 1.0, 1.0, 1.0])
+    fifth_of_a = (pd.Series(a_truth).rank(method="first").to_numpy() - 1) * 5 // 100
+    misses = np.bincount(fifth_of_a[:10].astype(int), minlength=5)
+    np.testing.assert_allclose(table.loc["A"], 1.0 - misses / 20)
 
 
 def test_hpd_mass_of_a_known_gaussian():

@@ -206,6 +206,23 @@ def coverage_table(trials: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
+def coverage_by_fifth(trials: pd.DataFrame, fifths: int = 5) -> pd.DataFrame:
+    """Where the intervals miss: per parameter (rows) and fifth of its truths (columns, by rank: the
+    lowest fifth of the truths first), the share of 90% intervals holding the truth, over the trials
+    that finished. Truths drawn evenly over the box (a Latin hypercube, uniform draws) put each fifth
+    of the truths in a fifth of the box; a method that is right everywhere gives about 0.90 in every
+    cell, with a binomial sd of sqrt(0.09 / (trials / fifths)) (0.067 for 20 trials a cell)."""
+    usable = usable_trials(trials).astype({"inside": bool})
+    columns = [f"{k}/{fifths}" for k in range(1, fifths + 1)]
+
+    def by_rank(group: pd.DataFrame) -> pd.Series:
+        rank = group["truth"].rank(method="first").to_numpy() - 1
+        fifth = (rank * fifths // len(group)).astype(int)
+        return pd.Series([group["inside"].to_numpy()[fifth == k].mean() for k in range(fifths)], columns)
+
+    return usable.groupby("parameter", sort=False)[["truth", "inside"]].apply(by_rank)
+
+
 def joint_coverage(trials: pd.DataFrame) -> dict:
     """The joint check from the trials' `truth_hpd_mass`: the share of trials whose truth lies in the
     90% highest-density region, its central 95% binomial band, and the Kolmogorov-Smirnov p-value of

@@ -160,13 +160,15 @@ def log_coverage(coverage, trials) -> None:
     """Log the per-parameter coverage and, when the trials carry it, the joint check (`joint_coverage`)."""
     import logging
 
-    from shockcal.coverage import joint_coverage, usable_trials
+    from shockcal.coverage import coverage_by_fifth, joint_coverage, usable_trials
 
     log = logging.getLogger("shockcal.calibrate")
     if "status" in trials:
         for trial, reason in trials[trials["status"] == "failed"].groupby("trial")["reason"].first().items():
             log.warning("trial %d failed and is left out: %s", trial, reason)
     log.info("coverage of nominal 90%% intervals:\n%s", coverage.to_string(index=False, float_format="%.3f"))
+    log.info("coverage per fifth of each parameter's truths (lowest first):\n%s",
+             coverage_by_fifth(trials).to_string(float_format="%.2f"))
     if "truth_hpd_mass" in trials and usable_trials(trials)["truth_hpd_mass"].notna().all():
         log.info("joint: truth in the 90%% highest-density region in %(coverage90).3f of %(trials)d trials "
                  "(band %(band_low).3f-%(band_high).3f); masses against uniform: KS p = %(uniform_ks_p).3g",
