@@ -1,6 +1,7 @@
 """Where in the box the emulator's 90% bands hold: the constant sd model against the smooth one (issue 36).
 
-On the paper's FLAG features (runs 0-499, joint, the study's code path and seeds), for each
+On the paper's FLAG features (runs 0-499, joint, the study's code path and seeds), or with `--study
+DIR` on a study's own training runs (DIR/training/design.parquet and features), for each
 `emulator.sd_model` (default both: constant, then smooth): fit (its 10-fold, everything refitted, is the
 sd calibration, and with `smooth` the variance model is refitted per fold, so each fold is judged by a
 calibration that never saw it) and the outer check (train on the runs with every design input in the
@@ -13,7 +14,7 @@ inner box [0.05, 0.95], predict the rest, with the full fit's calibration). Prin
   keeps each run's features together) gives each cell's sd and the spread of the smallest and largest
   of the 55 cells;
 - wall times (fit with its K-fold; outer check; prediction of 1000 points) with the load beside them.
-Usage: python benchmarks/emulator_variance.py [--sd-model constant smooth]
+Usage: python benchmarks/emulator_variance.py [--sd-model constant smooth] [--study results]
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ import numpy as np
 import pandas as pd
 
 from shockcal.emulator import fit_emulator
+from shockcal.io import read_table
 from shockcal.pcgp import Z90
 from shockcal.reference import reference_dir
-from shockcal.study.adapters import emulator_spec
+from shockcal.study.adapters import emulator_spec, load_study_design
 from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -110,21 +112,28 @@ def time_variance_model(model) -> None:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sd-model", nargs="+", default=["constant", "smooth"], choices=["constant", "smooth"])
+    parser.add_argument("--study", type=Path, help="a study's results folder: its training runs instead of FLAG's")
     args = parser.parse_args(argv)
-    ref = reference_dir()
-    if ref is None:
-        print("reference data not found: nothing to measure")
-        return 0
     config = load_config(REPO / "config" / "config.yaml")
-    design = pd.read_csv(ref / "design.csv")
-    flag = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
+    if args.study is None:
+        ref = reference_dir()
+        if ref is None:
+            print("reference data not found: nothing to measure")
+            return 0
+        design = pd.read_csv(ref / "design.csv")
+        features = {s: pd.read_csv(ref / f"flag_features_{s}.csv") for s in SHOTS}
+        source = "FLAG runs 0-499"
+    else:
+        design = load_study_design(args.study / "training" / "design.parquet", config)
+        features = {s: read_table(args.study / "training" / "features" / f"{s}.parquet") for s in SHOTS}
+        source = f"the training runs of {args.study}"
     inputs = {k: design[k].to_numpy() for k in design.columns if k != "run"}
     spec = emulator_spec(config, SHOTS)
     margin = config["emulator"]["outer_margin"]
     for sd_model in args.sd_model:
-        print(f"\nsd_model {sd_model} (FLAG runs 0-499, joint, {config['emulator']['cv_folds']}-fold, outer margin {margin})")
+        print(f"\nsd_model {sd_model} ({source}, joint, {config['emulator']['cv_folds']}-fold, outer margin {margin})")
         start = time.perf_counter()
-        emulator = fit_emulator(design, flag, replace(spec, settings=replace(spec.settings, sd_model=sd_model)))
+        emulator = fit_emulator(design, features, replace(spec, settings=replace(spec.settings, sd_model=sd_model)))
         print(f"  fit + {config['emulator']['cv_folds']}-fold calibration: {time.perf_counter() - start:.1f} s ({load()})")
         block = emulator.blocks[0]
         model, names = block.model, block.input_map.names
