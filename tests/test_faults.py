@@ -265,6 +265,7 @@ def _setting(config, path, value):
     ("inputs.A.min", 0.02, "inputs.A: min (0.02) must be below max"),
     ("shots.105S.velocity_input", "V9", "shots.105S.velocity_input: 'V9' is not one of the inputs"),
     ("design.file", "no/such/design.csv", "design.file: no/such/design.csv does not exist"),
+    ("calibration.replicates", 2, "calibration.replicates: 2 runs give no usable spread"),
 ])
 def test_config_faults(paper_config, path, value, fragment):
     _setting(paper_config, path, value)

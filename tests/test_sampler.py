@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from shockcal.errors import SamplerError
-from shockcal.sampler import WeightedDraws, nested_sample
+from shockcal.sampler import SamplerSettings, WeightedDraws, nested_sample, pool, sample
+from shockcal.summaries import SUMMARY_QUANTILES, quantile_mcse_between, weighted_quantiles
 
 
 def _box_transform(lower, upper):
@@ -109,3 +111,67 @@ def test_evidence_sd_matches_the_spread_over_seeds_and_the_truth():
     mean_z2 = np.mean(((log_z - truth) / reported) ** 2)
     assert 0.21 < mean_z2 < 2.51, (mean_z2, log_z - truth, reported)
     assert 0.21 < np.var(log_z, ddof=1) / np.mean(reported**2) < 2.51
+
+
+def test_pooled_runs_weigh_each_run_equally_and_average_their_evidence():
+    runs = [WeightedDraws(np.full((n, 1), float(r)), np.full(n, -np.log(n)), np.zeros(n), log_z, 10 * n, sd)
+            for r, (n, log_z, sd) in enumerate([(2, -1.0, 0.1), (3, -2.0, 0.2), (5, -1.5, 0.1)])]
+    pooled = pool(runs)
+    assert pooled.replicate.tolist() == [0, 0, 1, 1, 1, 2, 2, 2, 2, 2]
+    for r in range(3):
+        assert pooled.weights[pooled.replicate == r].sum() == pytest.approx(1 / 3)
+    z = np.exp([-1.0, -2.0, -1.5])
+    assert np.exp(pooled.log_evidence) == pytest.approx(z.mean())
+    assert pooled.log_evidence_sd == pytest.approx(np.sqrt(np.sum((z / z.sum()) ** 2 * np.array([0.1, 0.2, 0.1]) ** 2)))
+    assert pooled.n_likelihood == 100
+
+
+def test_quantile_errors_from_the_runs_spread_match_the_known_variance():
+    # 400 repetitions of 5 runs of 400 independent N(0, 1) draws: the mean squared error estimate of the
+    # pooled 5/50/95% points is var(one run's quantile) / 5 = p (1 - p) / (400 phi(z_p)^2) / 5; the
+    # estimate has 4 degrees of freedom (relative sd 0.71), so its mean over 400 is good to 3.5%
+    rng = np.random.default_rng(2)
+    p = np.array(SUMMARY_QUANTILES)
+    z = stats.norm.ppf(p)
+    expected = p * (1 - p) / (400 * stats.norm.pdf(z) ** 2) / 5
+    replicate = np.repeat(np.arange(5), 400)
+    squares = [quantile_mcse_between(rng.normal(size=2000), np.full(2000, 1 / 2000), replicate, p) ** 2
+               for _ in range(400)]
+    np.testing.assert_allclose(np.mean(squares, axis=0), expected, rtol=0.15)
+    with pytest.raises(ValueError, match="at least 3"):
+        quantile_mcse_between(np.arange(4.0), np.full(4, 0.25), np.array([0, 0, 1, 1]), p)
+
+
+class _ToyProblem:
+    """sample()'s view of a problem: one input x and lambda_y on the unit square, a Gaussian likelihood."""
+
+    names, ndim = ["x"], 2
+
+    def cube_power(self, powers, others):
+        return np.ones(2)
+
+    def prior_transform(self, u):
+        return u
+
+    def log_likelihood(self, theta):
+        return -0.5 * np.sum((theta - 0.4) ** 2, axis=1) / 0.02
+
+
+def test_replicates_pool_independent_runs_the_first_being_the_single_run():
+    """calibration.replicates 3 at n_eff 300: three runs to 100 each, the first with the calibration's
+    own seed (the single run at n_eff 100, draw for draw), the others from the replicate stream; the
+    summary's errors are the sd of the runs' own quantiles over sqrt(3)."""
+    single = sample(_ToyProblem(), SamplerSettings(n_live=100, n_eff=100, draws=500, seed=7))
+    pooled = sample(_ToyProblem(), SamplerSettings(n_live=100, n_eff=300, draws=500, seed=7, replicates=3))
+    runs = pooled.weighted.replicate
+    assert sorted(np.unique(runs)) == [0, 1, 2] and pooled.info()["replicates"] == 3
+    np.testing.assert_array_equal(pooled.weighted.points[runs == 0], single.weighted.points)
+    assert not np.array_equal(pooled.weighted.points[runs == 1][:50], single.weighted.points[:50])
+    table = pooled.weighted_table()
+    assert "replicate" in table and pooled.weighted.weights.sum() == pytest.approx(1.0)
+    own = np.array([weighted_quantiles(table.loc[runs == r, "x"].to_numpy(), pooled.weighted.weights[runs == r],
+                                       SUMMARY_QUANTILES) for r in range(3)])
+    np.testing.assert_allclose(pooled.summary().set_index("parameter").loc["x", ["q05_mcse", "q50_mcse", "q95_mcse"]]
+                               .to_numpy(float), own.std(axis=0, ddof=1) / np.sqrt(3))
+    with pytest.raises(ValueError, match="replicates 2"):
+        SamplerSettings(replicates=2)

@@ -29,6 +29,7 @@ from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
 from shockcal.progress import Every
+from shockcal.seeds import stream_seed
 from shockcal.summaries import summarize
 
 log = logging.getLogger("shockcal.sampler")
@@ -44,6 +45,7 @@ class WeightedDraws:
     log_evidence: float          # log marginal likelihood (the likelihood's constants included)
     n_likelihood: int            # likelihood evaluations spent
     log_evidence_sd: float = float("nan")   # its Monte Carlo sd (`evidence_sd`); NaN when unknown
+    replicate: np.ndarray | None = None     # (N,) which independent run each draw comes from (`pool`); None: one run
 
     @property
     def weights(self) -> np.ndarray:
@@ -116,6 +118,23 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
                          float(sampler.log_z), int(sampler.n_like), evidence_sd(sampler))
 
 
+def pool(runs: list[WeightedDraws]) -> WeightedDraws:
+    """Independent runs on one posterior as one set of weighted draws: each run's normalised weights
+    divided by the number of runs (an equal mixture of their estimates), the evidence the mean of
+    theirs (log Z = logsumexp(log Z_r) - log R) with the count-based sd of that mean, the evaluations
+    summed, and each draw's run in `replicate` (for Monte Carlo errors from the runs' spread,
+    `summaries.quantile_mcse_between`)."""
+    log_r = np.log(len(runs))
+    log_z = np.array([run.log_evidence for run in runs])
+    share = np.exp(log_z - logsumexp(log_z))
+    return WeightedDraws(np.concatenate([run.points for run in runs]),
+                         np.concatenate([run.log_weight - log_r for run in runs]),
+                         np.concatenate([run.log_likelihood for run in runs]),
+                         float(logsumexp(log_z) - log_r), int(sum(run.n_likelihood for run in runs)),
+                         float(np.sqrt(np.sum(share**2 * np.array([run.log_evidence_sd for run in runs]) ** 2))),
+                         np.concatenate([np.full(len(run.log_weight), r) for r, run in enumerate(runs)]))
+
+
 def evidence_sd(sampler) -> float:
     """Monte Carlo sd of a finished nautilus run's log Z, from its own counts (delta method).
 
@@ -164,6 +183,10 @@ class SamplerSettings:
         cube_power: unit-cube power of named inputs (`nested_sample`'s `cube_power`: where the sampler
             looks, not the posterior).
         max_evaluations: likelihood evaluations after which a run short of `n_eff` stops with an error.
+        replicates: independent runs (seeds `seed`, then the "replicate" streams of it), each to
+            n_eff / replicates, pooled (`pool`); from 3 on, the quantiles' Monte Carlo errors come from
+            the runs' spread, which also sees the bounds' own randomness (docs/calibration.md,
+            "Monte Carlo errors"). 1: one run, errors from its weights.
     """
 
     n_live: int = 500
@@ -172,6 +195,11 @@ class SamplerSettings:
     seed: int = 0
     cube_power: Mapping[str, float] = field(default_factory=dict)
     max_evaluations: int = 500_000
+    replicates: int = 1
+
+    def __post_init__(self):
+        if self.replicates < 1 or self.replicates == 2:
+            raise ValueError(f"replicates {self.replicates}: 1, or at least 3 (a spread needs three runs)")
 
 
 @dataclass
@@ -218,10 +246,13 @@ class Posterior:
         return table
 
     def weighted_table(self) -> pd.DataFrame:
-        """The weighted draws: the parameters, `log_weight` (normalised: logsumexp = 0) and `log_likelihood`."""
+        """The weighted draws: the parameters, `log_weight` (normalised: logsumexp = 0), `log_likelihood`
+        and, for pooled runs, `replicate`."""
         table = pd.DataFrame(self.weighted.points, columns=self.names)
         table["log_weight"] = self.weighted.log_weight
         table["log_likelihood"] = self.weighted.log_likelihood
+        if self.weighted.replicate is not None:
+            table["replicate"] = self.weighted.replicate
         return table
 
     def info(self) -> dict:
@@ -230,7 +261,8 @@ class Posterior:
                 "seed": self.settings.seed, "log_evidence": self.log_evidence,
                 "log_evidence_sd": self.log_evidence_sd, "likelihood_evaluations": self.weighted.n_likelihood,
                 "cube_power": self.cube_power, "weighted_draws": len(self.weighted.points),
-                "ess_kish": self.weighted.kish_ess(), "retained": len(self.draws),
+                "ess_kish": self.weighted.kish_ess(), "replicates": self.settings.replicates,
+                "retained": len(self.draws),
                 "distinct_draws": self.distinct_draws, **self.context}
 
     def __repr__(self) -> str:
@@ -253,8 +285,12 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
         The `Posterior`: weighted draws, `settings.draws` equal-weight draws resampled from them, evidence.
     """
     power = problem.cube_power(settings.cube_power, other_powers)
-    weighted = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live,
-                             settings.n_eff, settings.seed, power, settings.max_evaluations)
+    n_eff = int(np.ceil(settings.n_eff / settings.replicates))
+    runs = [nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings.n_live, n_eff,
+                          settings.seed if r == 0 else stream_seed(settings.seed, "replicate", r), power,
+                          settings.max_evaluations)
+            for r in range(settings.replicates)]
+    weighted = runs[0] if len(runs) == 1 else pool(runs)
     names = [*problem.names, "lambda_y"]
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     draws = pd.DataFrame(weighted.points[rows], columns=names)

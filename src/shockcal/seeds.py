@@ -19,6 +19,7 @@ keyed further (an emulator block index, a calibration's shots).
 | sensitivity | the Sobol sequence's scrambling and the bootstrap of the Sobol indices |
 | readout | the noise replicates of a measured record's read-out bootstrap (`shockcal observed`), keyed by shot |
 | next_shot | candidates' draws ("draws"), gains ("eig", name); the check's truths ("check_truths"), noise ("check_noise") |
+| replicate | a calibration's runs after its first (`calibration.replicates`), keyed by run, rooted at the calibration's seed |
 """
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ import zlib
 import numpy as np
 
 STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
-           "sensitivity", "readout", "next_shot")
+           "sensitivity", "readout", "next_shot", "replicate")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

@@ -10,20 +10,23 @@ SUMMARY_QUANTILES = (0.05, 0.5, 0.95)
 
 def summarize(draws, names: list[str]) -> pd.DataFrame:
     """Per parameter: weighted mean, sd, 5/50/95% quantiles with their Monte Carlo standard errors
-    (`quantile_mcse`), and the Kish ESS of the weights.
+    (`quantile_mcse` for one run; `quantile_mcse_between` for pooled runs), and the Kish ESS of the weights.
 
     Args:
-        draws: weighted draws (`shockcal.sampler.WeightedDraws`: points (N, d), normalised weights).
+        draws: weighted draws (`shockcal.sampler.WeightedDraws`: points (N, d), normalised weights, and
+            `replicate`, each draw's run, for pooled runs).
         names: the d parameters' names, in column order.
     """
     w, ess = draws.weights, draws.kish_ess()
+    replicate = getattr(draws, "replicate", None)
     rows = []
     for j, name in enumerate(names):
         x = draws.points[:, j]
         mean = float(np.sum(w * x))
         row = {"parameter": name, "mean": mean, "sd": float(np.sqrt(np.sum(w * (x - mean) ** 2)))}
-        for p, q, mcse in zip(SUMMARY_QUANTILES, weighted_quantiles(x, w, SUMMARY_QUANTILES),
-                              quantile_mcse(x, w, SUMMARY_QUANTILES)):
+        errors = (quantile_mcse(x, w, SUMMARY_QUANTILES) if replicate is None
+                  else quantile_mcse_between(x, w, replicate, SUMMARY_QUANTILES))
+        for p, q, mcse in zip(SUMMARY_QUANTILES, weighted_quantiles(x, w, SUMMARY_QUANTILES), errors):
             row[f"q{round(100 * p):02d}"], row[f"q{round(100 * p):02d}_mcse"] = q, mcse
         rows.append({**row, "ess": ess})
     return pd.DataFrame(rows)
@@ -42,6 +45,18 @@ def quantile_mcse(x: np.ndarray, w: np.ndarray, p) -> np.ndarray:
     upper = weighted_quantiles(x, w, np.minimum(p + a, 1.0))
     lower = weighted_quantiles(x, w, np.maximum(p - a, 0.0))
     return 0.5 * (upper - lower)
+
+
+def quantile_mcse_between(x: np.ndarray, w: np.ndarray, replicate: np.ndarray, p) -> np.ndarray:
+    """Monte Carlo standard error of the p-quantiles of R >= 3 pooled independent runs (`replicate`:
+    each draw's run; each run's weights summing to 1 / R): the sd of the runs' own quantile estimates
+    over sqrt(R). It sees every source of error of a run, the sampler's adaptive bounds included,
+    where `quantile_mcse` sees only the weights of one run."""
+    runs = np.unique(replicate)
+    if len(runs) < 3:
+        raise ValueError(f"{len(runs)} runs: the spread of quantiles needs at least 3")
+    estimates = np.array([weighted_quantiles(x[replicate == r], w[replicate == r], p) for r in runs])
+    return estimates.std(axis=0, ddof=1) / np.sqrt(len(runs))
 
 
 def weighted_quantiles(x: np.ndarray, w: np.ndarray, q) -> np.ndarray:

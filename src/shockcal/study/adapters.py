@@ -157,7 +157,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     seed = stream_seed(config["study"]["seed"], "calibration", *shots)
     sampler = SamplerSettings(n_live=section["n_live"], n_eff=section["n_eff"], draws=draws, seed=seed,
                               cube_power=config["calibration"]["cube_power"],
-                              max_evaluations=config["calibration"]["max_evaluations"])
+                              max_evaluations=config["calibration"]["max_evaluations"],
+                              replicates=1 if check else config["calibration"]["replicates"])
     boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots if shot in config["shots"]}
     return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
                                {name: box["unit"] for name, box in config["inputs"].items()}, prior_bounds(config),

@@ -55,7 +55,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # one calibration (single shot or joint)
     "calibrate": ("study.seed", "calibration.n_live", "calibration.n_eff", "calibration.draws",
-                  "calibration.cube_power", "calibration.max_evaluations", "observed.sd_fraction",
+                  "calibration.replicates", "calibration.cube_power", "calibration.max_evaluations", "observed.sd_fraction",
                   "checks.observed_units", "checks.plateau_vs_velocity", "inputs", *_SHOT_MAPPING),
     # a batch of synthetic-truth trials
     "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",

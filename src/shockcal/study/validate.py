@@ -149,6 +149,9 @@ def check_semantics(config: dict, source: str = "config") -> None:
                 raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
     for shot, spec in config["shots"].items():
         check_initial_temperature(spec, config["material"], f"{source}: shots.{shot}.initial_temperature_K")
+    if config["calibration"]["replicates"] == 2:
+        raise ConfigError(f"{source}: calibration.replicates: 2 runs give no usable spread of their quantiles; "
+                          "use 1, or 3 or more")
     for name in config["calibration"]["cube_power"]:
         if name not in inputs:
             raise ConfigError(f"{source}: calibration.cube_power.{name}: not one of the inputs {sorted(inputs)}")
