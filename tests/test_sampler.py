@@ -161,8 +161,8 @@ def test_replicates_pool_independent_runs_the_first_being_the_single_run():
     """calibration.replicates 3 at n_eff 300: three runs to 100 each, the first with the calibration's
     own seed (the single run at n_eff 100, draw for draw), the others from the replicate stream; the
     summary's errors are the sd of the runs' own quantiles over sqrt(3)."""
-    single = sample(_ToyProblem(), SamplerSettings(n_live=100, n_eff=100, draws=500, seed=7))
-    pooled = sample(_ToyProblem(), SamplerSettings(n_live=100, n_eff=300, draws=500, seed=7, replicates=3))
+    single = sample(_ToyProblem(), SamplerSettings(n_live=50, n_eff=100, draws=500, seed=7))
+    pooled = sample(_ToyProblem(), SamplerSettings(n_live=50, n_eff=300, draws=500, seed=7, replicates=3))
     runs = pooled.weighted.replicate
     assert sorted(np.unique(runs)) == [0, 1, 2] and pooled.info()["replicates"] == 3
     np.testing.assert_array_equal(pooled.weighted.points[runs == 0], single.weighted.points)
