@@ -18,14 +18,13 @@ def summarize(draws, names: list[str]) -> pd.DataFrame:
         names: the d parameters' names, in column order.
     """
     w, ess = draws.weights, draws.kish_ess()
-    replicate = getattr(draws, "replicate", None)
     rows = []
     for j, name in enumerate(names):
         x = draws.points[:, j]
         mean = float(np.sum(w * x))
         row = {"parameter": name, "mean": mean, "sd": float(np.sqrt(np.sum(w * (x - mean) ** 2)))}
-        errors = (quantile_mcse(x, w, SUMMARY_QUANTILES) if replicate is None
-                  else quantile_mcse_between(x, w, replicate, SUMMARY_QUANTILES))
+        errors = (quantile_mcse(x, w, SUMMARY_QUANTILES) if draws.replicate is None
+                  else quantile_mcse_between(x, w, draws.replicate, SUMMARY_QUANTILES))
         for p, q, mcse in zip(SUMMARY_QUANTILES, weighted_quantiles(x, w, SUMMARY_QUANTILES), errors):
             row[f"q{round(100 * p):02d}"], row[f"q{round(100 * p):02d}_mcse"] = q, mcse
         rows.append({**row, "ess": ess})
