@@ -13,6 +13,7 @@ rule features_chunk:
         f"{BENCHMARKS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.tsv"
     wildcard_constraints:
         run_set="|".join(RUN_SET_SIZES),
+    priority: 5  # with its simulation chunk: the fan-out first
     conda:
         "../envs/shockcal.yaml"
     params:
