@@ -53,7 +53,7 @@ models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into res
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
 	snakemake --cores $(CORES) check
 
-next-shot: $(INSTALLED)  ## which shot next (issue 38): rank next_shot.candidates by expected information gain
+next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain
 	snakemake --cores $(CORES) next_shot
 	@echo "ranking: $(CURDIR)/results/next_shot/ranking.csv"
 

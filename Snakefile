@@ -49,7 +49,7 @@ rule all:
 
 
 rule next_shot:
-    """Which shot next (issue 38): the candidates' ranking and its figure; `make next-shot`, outside `all`
+    """Which shot next: the candidates' ranking and its figure; `make next-shot`, outside `all`
     (next_shot.n_draws hydrocode runs per candidate, docs/next_shot.md)."""
     input:
         rules.suggest_shot.output,
@@ -57,7 +57,7 @@ rule next_shot:
 
 
 rule next_shot_check:
-    """The realized check of the ranking (issue 38): `make next-shot-check`, outside `all` (docs/next_shot.md,
+    """The realized check of the ranking: `make next-shot-check`, outside `all` (docs/next_shot.md,
     "The realized check": its cost)."""
     input:
         rules.next_shot_check_summary.output if CHECK_PLANS else [],

@@ -12,7 +12,7 @@ For each calibration (joint, then each shot) on a fitted emulator and measured f
              ArviZ's R-hat and bulk ESS, as a yardstick;
   dynesty    (--dynesty N_LIVE) static nested sampling with random slices, the independent
              cross-check of the reference (--replicates 0 skips the default runs).
-Goal (issue 14): ESS >= 1000 per parameter, worst quantile error <= 0.02 of the box, <= 60 s wall.
+Goal: ESS >= 1000 per parameter, worst quantile error <= 0.02 of the box, <= 60 s wall.
 
     .venv/bin/python benchmarks/bench_calibration.py --emulator DIR [--observed TABLE] [--only joint]
 """
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.summaries import quantile_mcse, weighted_quantiles
+from shockcal.inference.summaries import quantile_mcse, weighted_quantiles
 
 REPO = Path(__file__).resolve().parents[1]
 QUANTILES = [0.05, 0.25, 0.5, 0.75, 0.95]
@@ -94,7 +94,7 @@ def quantile_z(draws, ref: pd.DataFrame, names) -> tuple[float, str]:
 
 def run_default(problem, settings, seed):
     """The configured nautilus run: equal-weight draws (resampled), wall and CPU seconds, evaluations."""
-    from shockcal.sampler import nested_sample
+    from shockcal.inference.sampler import nested_sample
 
     start, cpu = time.perf_counter(), time.process_time()
     draws = nested_sample(problem.prior_transform, problem.log_likelihood, problem.ndim, settings["n_live"],
@@ -134,7 +134,7 @@ def run_dynesty(problem, n_live: int, seed: int, keep: Path):
     import dynesty
     from dynesty.utils import resample_equal
 
-    from shockcal.sampler import WeightedDraws
+    from shockcal.inference.sampler import WeightedDraws
 
     rng = np.random.default_rng(seed)
     start, cpu = time.perf_counter(), time.process_time()
@@ -201,9 +201,9 @@ def run_emcee(problem, evaluations: int, seed: int):
 
 
 def main(argv=None) -> int:
-    from shockcal.emulator import Emulator
+    from shockcal.emulator.study_emulator import Emulator
+    from shockcal.inference.problem import Problem
     from shockcal.io import read_table
-    from shockcal.problem import Problem
     from shockcal.study.validate import load_config
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

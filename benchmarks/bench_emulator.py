@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.emulator import fit_emulator, rmse_table
-from shockcal.features import CALIBRATION_FEATURES
+from shockcal.emulator.study_emulator import fit_emulator, rmse_table
 from shockcal.reference import reference_dir
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 SHOTS = ["104S", "105S", "106S"]

@@ -21,10 +21,10 @@ import pandas as pd
 from scipy.stats import norm
 from threadpoolctl import threadpool_limits
 
-from shockcal.features import extract, extract_features, features_table
-from shockcal.records import read_record
 from shockcal.study.adapters import extractor_settings
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.features import extract, extract_features, features_table
+from shockcal.velocimetry.records import read_record
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIG = REPO / "config" / "config.yaml"

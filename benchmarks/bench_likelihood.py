@@ -1,4 +1,4 @@
-"""Calibration speed (issue 35): likelihood evaluations per second, where an evaluation's time goes,
+"""Calibration speed: likelihood evaluations per second, where an evaluation's time goes,
 and the joint calibration's wall time, each beside the figure before 2026-11-26 ("before") measured in the same run.
 
 On the study's emulator and measured features (`results/emulator`, `results/features/observed.parquet`;
@@ -44,7 +44,7 @@ def load() -> str:
 def previous_predict_weights(model, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The yardstick "before": `PCGPEmulator._predict_weights` of main before 2026-11-26, the
     cross-covariances on `n_jobs` Python threads, then every component's solve on `n_jobs` BLAS threads."""
-    from shockcal.pcgp import _blas_threads
+    from shockcal.emulator.pcgp import _blas_threads
 
     threads = model.settings.n_jobs
     with ThreadPoolExecutor(threads) as pool:
@@ -79,7 +79,7 @@ def evaluation_points(problem, posterior: Path, n: int, rng) -> tuple[np.ndarray
 def likelihood_costs(problem, emulator, points: np.ndarray) -> dict[str, float]:
     """Per point (us): the likelihood now and before; the basis weights' mean, and their mean and
     variance now and before (the variance is their difference)."""
-    from shockcal.pcgp import PCGPEmulator
+    from shockcal.emulator.pcgp import PCGPEmulator
 
     block = emulator.blocks[0]
     model = block.model
@@ -102,8 +102,8 @@ def likelihood_costs(problem, emulator, points: np.ndarray) -> dict[str, float]:
 
 def timed_calibration(emulator, shots, observed, config, label: str) -> dict:
     """The study's calibration of `shots` (settings and seed), with the seconds spent in the likelihood."""
-    from shockcal.problem import Problem
-    from shockcal.sampler import sample
+    from shockcal.inference.problem import Problem
+    from shockcal.inference.sampler import sample
     from shockcal.study.adapters import calibration_settings
 
     settings = calibration_settings(config, shots)
@@ -129,9 +129,9 @@ def timed_calibration(emulator, shots, observed, config, label: str) -> dict:
 
 
 def main(argv=None) -> int:
-    from shockcal.emulator import Emulator
+    from shockcal.emulator.study_emulator import Emulator
+    from shockcal.inference.problem import Problem
     from shockcal.io import read_table
-    from shockcal.problem import Problem
     from shockcal.study.validate import load_config
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

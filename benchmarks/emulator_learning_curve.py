@@ -1,4 +1,4 @@
-"""How the emulator's error on unseen runs falls with the training runs per shot (issue 16: what a
+"""How the emulator's error on unseen runs falls with the training runs per shot (what a
 smaller design would cost in accuracy, against what it saves in hydrocode time).
 
 Fits the study's emulator (config/config.yaml settings) on the first N runs of the study's training
@@ -22,10 +22,10 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.emulator import fit_emulator
-from shockcal.features import CALIBRATION_FEATURES
+from shockcal.emulator.study_emulator import fit_emulator
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 

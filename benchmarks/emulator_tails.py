@@ -22,9 +22,9 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.coverage import HydroTruths, _noisy_features
-from shockcal.emulator import Emulator
-from shockcal.error_model import ErrorModel
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.emulator.study_emulator import Emulator
+from shockcal.inference.coverage import HydroTruths, _noisy_features
 from shockcal.study.validate import load_config
 
 NOISE_DRAWS = 50

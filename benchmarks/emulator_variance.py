@@ -1,4 +1,4 @@
-"""Where in the box the emulator's 90% bands hold: the constant sd model against the smooth one (issue 36).
+"""Where in the box the emulator's 90% bands hold: the constant sd model against the smooth one.
 
 On the paper's FLAG features (runs 0-499, joint, the study's code path and seeds), or with `--study
 DIR` on a study's own training runs (DIR/training/design.parquet and features), for each
@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.emulator import fit_emulator
+from shockcal.emulator.pcgp import Z90
+from shockcal.emulator.study_emulator import fit_emulator
 from shockcal.io import read_table
-from shockcal.pcgp import Z90
 from shockcal.reference import reference_dir
 from shockcal.study.adapters import emulator_spec, load_study_design
 from shockcal.study.validate import load_config
@@ -94,7 +94,7 @@ def report(label: str, x: np.ndarray, held, y: np.ndarray, names, rng) -> dict:
 def time_variance_model(model) -> None:
     """The variance model's own cost: one fit on the K-fold's 500 x 12 values (the calibration makes
     cv_folds + 1 of them) and its factors at 1000 points (added to every prediction)."""
-    from shockcal.variance_model import VarianceModel
+    from shockcal.emulator.variance_model import VarianceModel
 
     v, held = model.variance, model.kfold
     x = model.x_train[held.rows]

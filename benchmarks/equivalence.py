@@ -1,4 +1,4 @@
-"""Is a speed change statistically invisible? (issue 35's criterion, docs/hydro.md "Speed").
+"""Is a speed change statistically invisible? (the criterion for speed changes, docs/hydro.md "Speed").
 
     python benchmarks/equivalence.py features --out ref.parquet                 # the code on PYTHONPATH
     python benchmarks/equivalence.py features --out floor.parquet --perturb 1e-12
@@ -29,10 +29,10 @@ CONFIG = REPO / "config" / "config.yaml"
 
 
 def features(out: str, runs: int, perturb: float, config_path: Path, cfl: float | None) -> None:
-    from shockcal.features import features_table
-    from shockcal.simulate import simulate_design
+    from shockcal.simulators.builtin import simulate_design
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping, study_design
     from shockcal.study.validate import load_config
+    from shockcal.velocimetry.features import features_table
 
     config = load_config(config_path)
     if cfl is not None:
@@ -55,7 +55,7 @@ def features(out: str, runs: int, perturb: float, config_path: Path, cfl: float 
 
 
 def compare(reference: str, candidate: str, floor: str) -> None:
-    from shockcal.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     keys = ["shot", "run"]
     ref, cand, flo = (pd.read_parquet(p).set_index(keys).sort_index() for p in (reference, candidate, floor))

@@ -25,11 +25,11 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
-from shockcal.features import COLUMNS, features_table, record_features
 from shockcal.reference import require_reference_dir
-from shockcal.simulate import simulate_design
+from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import emulator_spec, extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.features import COLUMNS, features_table, record_features
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 SHOTS = ["104S", "105S", "106S"]
@@ -93,9 +93,9 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
                           config: dict) -> pd.DataFrame:
     """Per calibration feature: R^2 of a 10-fold GP prediction of ours - FLAG from the shot's inputs
     (with the emulator's input powers), and the scatter sd (m/s) it leaves."""
-    from shockcal.emulator import shot_input_map
-    from shockcal.features import CALIBRATION_FEATURES
-    from shockcal.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.study_emulator import shot_input_map
+    from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     ok = ours[ours["status"] == "ok"].set_index("run")
     spec = emulator_spec(config, [shot])

@@ -1,4 +1,4 @@
-"""The evidence with the prior box halved and doubled, from one run's weighted draws (shockcal.box_sensitivity),
+"""The evidence with the prior box halved and doubled, from one run's weighted draws (shockcal.campaign.box_sensitivity),
 against closed forms: a Gaussian likelihood in a 2-D box (Z of any sub-box from the normal CDF), and a
 likelihood that vanishes outside the box."""
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special, stats
 
-from shockcal.box_sensitivity import (
+from shockcal.campaign.box_sensitivity import (
     box_sensitivity,
     double_box_log_z,
     doubled_box,
@@ -18,7 +18,7 @@ from shockcal.box_sensitivity import (
     mass_near_moved_faces,
     physical_floor,
 )
-from shockcal.sampler import WeightedDraws
+from shockcal.inference.sampler import WeightedDraws
 
 LOWER, UPPER = np.array([1.0, 0.0]), np.array([3.0, 2.0])        # box volume 4; centre (2, 1)
 MU, SD = np.array([2.1, 0.9]), 0.3                                  # a normalised Gaussian likelihood

@@ -5,13 +5,13 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from shockcal.calibration import calibrate
-from shockcal.error_model import ErrorModel
+from shockcal.emulator.error_model import ErrorModel
 from shockcal.errors import InputError
-from shockcal.problem import LAMBDA_Y_PRIOR, Problem, observed_vector
-from shockcal.sampler import SamplerSettings, sample
+from shockcal.inference.calibration import calibrate
+from shockcal.inference.problem import LAMBDA_Y_PRIOR, Problem, observed_vector
+from shockcal.inference.sampler import SamplerSettings, sample
+from shockcal.inference.summaries import SUMMARY_QUANTILES, quantile_mcse, weighted_quantiles
 from shockcal.study.adapters import calibration_settings
-from shockcal.summaries import SUMMARY_QUANTILES, quantile_mcse, weighted_quantiles
 
 
 class StandInEmulator:

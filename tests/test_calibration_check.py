@@ -11,8 +11,10 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from shockcal.calibration import calibrate
-from shockcal.coverage import (
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.errors import InputError
+from shockcal.inference.calibration import calibrate
+from shockcal.inference.coverage import (
     HydroTruths,
     coverage_by_fifth,
     coverage_table,
@@ -20,9 +22,7 @@ from shockcal.coverage import (
     joint_coverage,
     synthetic_truth,
 )
-from shockcal.error_model import ErrorModel
-from shockcal.errors import InputError
-from shockcal.problem import Problem, log_density
+from shockcal.inference.problem import Problem, log_density
 from shockcal.study.adapters import calibration_settings
 
 FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -32,7 +32,7 @@ SHOT_INPUTS = {"104S": ["A", "B", "C", "n", "m", "V1", "G1"],
 
 
 class ShotEmulator:
-    """Same interface as shockcal.emulator.Emulator: features linear in the box-scaled inputs."""
+    """Same interface as shockcal.emulator.study_emulator.Emulator: features linear in the box-scaled inputs."""
 
     feature_names = FEATURES
 
@@ -331,7 +331,7 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     config_path.write_text(yaml.safe_dump(small_config))
     emu = ShotEmulator(small_config)
     observed_at(emu, ["104S"], mid_box(emu, ["104S"])).to_csv(tmp_path / "obs.csv", index=False)
-    monkeypatch.setattr("shockcal.emulator.Emulator.load", classmethod(lambda cls, path: emu))
+    monkeypatch.setattr("shockcal.emulator.study_emulator.Emulator.load", classmethod(lambda cls, path: emu))
     out = tmp_path / "post" / "104S.parquet"
     args = ["calibrate", "--config", str(config_path), "--emulator", "E", "--shots", "104S",
             "--observed", str(tmp_path / "obs.csv"), "--out", str(out)]

@@ -1,4 +1,4 @@
-"""Next-shot candidates (issue 38): the config's candidates and their bad input, a candidate's design
+"""Next-shot candidates: the config's candidates and their bad input, a candidate's design
 from the joint posterior, the elastic-plastic split, the score and the ranking `shockcal suggest-shot`
 writes (docs/next_shot.md). The estimator itself is tests/test_next_shot.py's; the workflow target
 end to end is tests/test_workflow.py's."""
@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.candidates import (
+from shockcal.campaign.candidates import (
     SHEAR_MODULUS,
     SLOPE,
     VELOCITY,
@@ -30,13 +30,13 @@ from shockcal.candidates import (
 )
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
-from shockcal.features import CALIBRATION_FEATURES
 from shockcal.hydro import AL5083
 from shockcal.io import write_table
 from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
 from shockcal.study.strength import next_shot_targets
 from shockcal.study.validate import validate_config
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 HOT = "104S-3.95x5.965mm-204ms-700K"

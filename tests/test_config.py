@@ -102,7 +102,7 @@ def test_unreadable_files(tmp_path):
 
 def test_the_library_validates_a_config_without_snakemake():
     """A notebook user needs neither snakemake installed nor imported: the schema check is jsonschema's."""
-    code = ("import sys; from shockcal.study.validate import load_config; import shockcal.cli, shockcal.simulate; "
+    code = ("import sys; from shockcal.study.validate import load_config; import shockcal.cli, shockcal.simulators.builtin; "
             "load_config('config/config.yaml'); print(sorted(m for m in sys.modules if m.startswith('snakemake')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=REPO)
     assert out.stdout.strip() == "[]"
@@ -124,8 +124,8 @@ def test_extractor_settings_defaults_are_the_schemas():
     """`ExtractorSettings()` (the notebook default) and a config that leaves the extractor out agree."""
     from dataclasses import asdict
 
-    from shockcal.features import ExtractorSettings
     from shockcal.study.validate import SCHEMA_PATH
+    from shockcal.velocimetry.features import ExtractorSettings
 
     schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]
     sections = [schema["features"], schema["shots"]["additionalProperties"]["properties"]["analysis"]]

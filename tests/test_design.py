@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from shockcal.cli import main
-from shockcal.design import chunk_fingerprints, latin_hypercube
+from shockcal.design.tables import chunk_fingerprints, latin_hypercube
 from shockcal.errors import InputError
 from shockcal.io import read_table
 from shockcal.study.adapters import input_box, load_study_design, shot_mapping
@@ -85,7 +85,7 @@ def test_design_depends_on_inputs_and_seed_not_on_their_order(paper_config):
 def test_write_design_rewrites_only_changed_rows(paper_config, tmp_path):
     """The workflow writes the design every time it is read: the same rows leave the file (and its
     mtime, which the emulator's rerun follows) alone, from any source; other rows replace it."""
-    from shockcal.design import write_design
+    from shockcal.design.tables import write_design
 
     design, path = latin_hypercube(prior_bounds(paper_config), 6, seed=1), tmp_path / "design.parquet"
     assert write_design(design, "Latin hypercube, seed 1", input_box(paper_config), path)

@@ -6,12 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.emulator import Emulator, fit_emulator, rmse_table
+from shockcal.emulator.gp import GaussianProcess
+from shockcal.emulator.study_emulator import Emulator, fit_emulator, rmse_table
 from shockcal.errors import InputError
-from shockcal.features import CALIBRATION_FEATURES
-from shockcal.gp import GaussianProcess
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.config import prior_bounds
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 NOISE = 0.05
 
@@ -50,7 +50,7 @@ def test_closed_form_loo_equals_brute_force_refitting():
 
 def _synthetic_study(paper_config, n=60, seed=3):
     """A design over the paper's box whose 104S features are a known function of A, B, n."""
-    from shockcal.design import latin_hypercube
+    from shockcal.design.tables import latin_hypercube
 
     design = latin_hypercube(prior_bounds(paper_config), n, seed)
     lo = np.array([paper_config["inputs"][k]["min"] for k in ("A", "B", "n")])
@@ -97,7 +97,7 @@ def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path
 
 
 def test_failed_and_nan_runs_are_dropped(paper_config, caplog):
-    caplog.set_level("INFO", logger="shockcal.emulator")
+    caplog.set_level("INFO", logger="shockcal.emulator.study_emulator")
     design, features, _ = _synthetic_study(paper_config, n=30)
     features.loc[0, "status"] = "failed"
     features.loc[1, "v_plastic"] = np.nan
@@ -149,7 +149,7 @@ def test_cli_first_runs_fits_on_the_designs_first_rows_only(tmp_path, paper_conf
     import yaml
 
     from shockcal.cli import main
-    from shockcal.emulator import Emulator
+    from shockcal.emulator.study_emulator import Emulator
 
     design, features, _ = _synthetic_study(paper_config, n=30)
     design.to_csv(tmp_path / "design.csv", index=False)

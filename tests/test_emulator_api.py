@@ -5,9 +5,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.correlation import FAMILIES, family_code, value_and_slope
-from shockcal.gp import GaussianProcess
-from shockcal.pcgp import PCGPEmulator, Settings, Switch
+from shockcal.emulator.correlation import FAMILIES, family_code, value_and_slope
+from shockcal.emulator.gp import GaussianProcess
+from shockcal.emulator.pcgp import PCGPEmulator, Settings, Switch
 from shockcal.study.adapters import emulator_spec
 
 NOISE = 0.05
@@ -49,7 +49,7 @@ def test_kernel_slope_is_the_derivative(family):
 def test_correlation_matrix_matches_the_formula(family):
     from scipy.spatial.distance import cdist
 
-    from shockcal.gp import correlation
+    from shockcal.emulator.gp import correlation
 
     rng = np.random.default_rng(7)
     a, b, beta = rng.uniform(size=(7, 3)), rng.uniform(size=(5, 3)), np.array([0.5, 4.0, 20.0])
@@ -63,7 +63,7 @@ def test_correlation_matrix_matches_the_formula(family):
 def test_gradient_of_the_hyperparameter_posterior(family):
     from scipy.optimize import check_grad
 
-    from shockcal.gp import neg_log_posterior
+    from shockcal.emulator.gp import neg_log_posterior
 
     rng = np.random.default_rng(5)
     x = rng.uniform(size=(30, 2))
@@ -157,10 +157,10 @@ def test_predict_emulator_writes_every_run_shot_and_feature(tmp_path, paper_conf
     import yaml
 
     from shockcal.cli import main
-    from shockcal.design import latin_hypercube
-    from shockcal.emulator import Emulator, fit_emulator
-    from shockcal.features import CALIBRATION_FEATURES
+    from shockcal.design.tables import latin_hypercube
+    from shockcal.emulator.study_emulator import Emulator, fit_emulator
     from shockcal.study.config import prior_bounds
+    from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     design = latin_hypercube(prior_bounds(paper_config), 30, 1)
     features = pd.DataFrame({f: 100 + 50 * design["A"] / 0.01 + 10 * i + 1e3 * design["V1"]

@@ -1,4 +1,4 @@
-"""The smooth emulator error variance (`emulator.sd_model: smooth`, `shockcal.variance_model`): on a
+"""The smooth emulator error variance (`emulator.sd_model: smooth`, `shockcal.emulator.variance_model`): on a
 function whose scatter grows near one face of the box, its K-fold bands hold in every fifth of that
 input's box where the constant sd factors' do not; it scales the covariance as D C D; it is saved,
 loaded and refused in old files; the same seed gives the same model."""
@@ -8,9 +8,9 @@ import json
 import numpy as np
 import pytest
 
+from shockcal.emulator.pcgp import Z90, PCGPEmulator, Settings
+from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
-from shockcal.pcgp import Z90, PCGPEmulator, Settings
-from shockcal.variance_model import VarianceModel
 
 N = 400
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
-from shockcal.error_model import ErrorModel
-from shockcal.pcgp import PCGPEmulator, Settings
-from shockcal.problem import Problem
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.emulator.pcgp import PCGPEmulator, Settings
+from shockcal.inference.problem import Problem
 
 
 def _spd(rng, f):

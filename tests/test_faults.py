@@ -16,20 +16,20 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.calibration import calibrate
 from shockcal.cli import main, parse_pairs, parse_span
-from shockcal.design import latin_hypercube
-from shockcal.emulator import Emulator, training_data
-from shockcal.error_model import ErrorModel
+from shockcal.design.tables import latin_hypercube
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.emulator.study_emulator import Emulator, training_data
 from shockcal.errors import ConfigError, InputError, ShockcalError
-from shockcal.features import check_failures
+from shockcal.inference.calibration import calibrate
+from shockcal.inference.predict import draw_posterior_design
+from shockcal.inference.problem import Problem
 from shockcal.io import atomic_path, read_table, read_tables, write_table
-from shockcal.predict import draw_posterior_design
-from shockcal.problem import Problem
-from shockcal.records import OPT_OUT, read_record
 from shockcal.study.adapters import calibration_settings, load_study_design, shot_mapping
 from shockcal.study.config import prior_bounds
 from shockcal.study.validate import load_config, validate_config
+from shockcal.velocimetry.features import check_failures
+from shockcal.velocimetry.records import OPT_OUT, read_record
 
 REPO = Path(__file__).resolve().parents[1]
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
@@ -367,7 +367,7 @@ def test_truncated_chunk_is_named_with_the_way_out(tmp_path, capsys):
     assert not (tmp_path / "features.parquet").exists()
 
 
-# ==== issue 36: the classes of fault, not the examples ============================================
+# ==== the classes of fault, not the examples ======================================================
 # Each message is one line (the CLI prints it alone) naming the file, key or shot; (a)-(c) name both
 # sides of a conflict; (d) every reader survives damaged files; (e) inputs fine in substance read the
 # same as the clean input.
@@ -383,8 +383,8 @@ def _one_line(err, *fragments):
 def _small_emulator(config, directory=None):
     """A real 104S-only study emulator (20 runs of smooth made-up features on the paper's box), saved
     to `directory` when given."""
-    from shockcal.emulator import Block, Emulator, shot_input_map
-    from shockcal.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.study_emulator import Block, Emulator, shot_input_map
 
     bounds = prior_bounds(config)
     mapping = shot_mapping(config, "104S")
@@ -687,7 +687,7 @@ def _read_posterior(path, config):
 
 
 def _read_chunk(path, config):
-    from shockcal.features import ExtractorSettings, features_table
+    from shockcal.velocimetry.features import ExtractorSettings, features_table
 
     return features_table(read_table(path), ExtractorSettings(window_after_arrival_us=0.1, n_samples=300,
                                                               n_components=2), str(path))

@@ -10,7 +10,8 @@ import pytest
 from scipy.stats import norm
 
 from shockcal.errors import InputError
-from shockcal.features import (
+from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.features import (
     COLUMNS,
     Mixture,
     extract,
@@ -23,9 +24,8 @@ from shockcal.features import (
     record_features,
     split_early,
 )
-from shockcal.mixture_fit import fit_piecewise_linear_cdf
-from shockcal.records import read_record
-from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.mixture_fit import fit_piecewise_linear_cdf
+from shockcal.velocimetry.records import read_record
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "al5083"   # the shipped records and published features
 
@@ -289,7 +289,7 @@ def test_features_table_marks_unreadable_traces_failed_and_goes_on(paper_config)
 
 
 # Measured records against the features published with the paper (observed_features.csv, the paper's
-# own extractor). Bounds are just above the measured differences where those are within the issue's
+# own extractor). Bounds are just above the measured differences where those are within the accepted
 # worst case (3 m/s, 10 ns); t_plastic is not compared (the 0.995 crossing of a slowly rising noisy
 # plateau: -262, +86 and +302 ns with the isotonic fit). Cases beyond the worst case keep that bound and
 # are xfail with the measured difference. Read robustly (isotonic fit, local linear reads over the
@@ -331,7 +331,7 @@ def test_measured_record_matches_published_features(record_differences, shot, co
     assert abs(record_differences[shot][column]) <= bound
 
 
-# The exact fit (shockcal.mixture_fit): EM on the piecewise-linear CDF itself, the limit of infinitely
+# The exact fit (shockcal.velocimetry.mixture_fit): EM on the piecewise-linear CDF itself, the limit of infinitely
 # many PIT samples. A trace that is exactly a two-Gaussian CDF (window 0.9-1.6 us, 0.5 ns grid) is
 # read by the extractor as the piecewise-linear interpolation of that CDF, whose components are the
 # Gaussians' with each variance raised by at most h^2/6 (h = 0.5 ns: the uniform spread inside the
@@ -397,7 +397,7 @@ def test_slope_times_stay_inside_the_window_when_the_late_mixture_is_one_broad_c
     """A single-wave trace (large A) can leave EM one broad component of a few 1e-5 of the mass spread
     over the plateau; its 0.9 quantile lies past the window, where the release has come: the slope times
     are read at the window's end instead (the study's 104S runs 349 and 748 read v_slope2 = 0.001 m/s)."""
-    from shockcal.features import Mixture, feature_times, feature_values
+    from shockcal.velocimetry.features import Mixture, feature_times, feature_values
 
     t = np.linspace(0.0, 2.4, 4801)
     v = np.where(t < 0.88, 0.0, 213.0) * (t < 2.2)           # one wave, then the release at 2.2 us

@@ -1,4 +1,4 @@
-"""A shot's initial temperature (issue 38): hot plates start expanded at zero pressure, the elastic precursor
+"""A shot's initial temperature: hot plates start expanded at zero pressure, the elastic precursor
 falls as the Johnson-Cook thermal factor says, a room-temperature shot is the code before it bit for bit."""
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ import pytest
 from shockcal.errors import ConfigError
 from shockcal.hydro import AL5083, Geometry, HydroSettings, ShotParameters, run_shot
 from shockcal.hydro.eos import cold_pressure
-from shockcal.hydro.solver import Strength, initial_mesh
+from shockcal.hydro.solver import initial_mesh
+from shockcal.hydro.state import Strength
 from shockcal.hydro.strength import thermal_factor
 from shockcal.study.adapters import hydro_inputs
 from shockcal.study.stages import stage_config

@@ -17,7 +17,7 @@ from shockcal.errors import InputError
 from shockcal.hydro import AL5083, Geometry, LawShotParameters, ShotParameters, run_shot
 from shockcal.hydro import shot as shot_module
 from shockcal.hydro.laws import get_law
-from shockcal.hydro.solver import LawStrength
+from shockcal.hydro.state import LawStrength
 from shockcal.units import CM_US_TO_M_S
 
 THIN = Geometry(flyer_mm=1.0, target_mm=1.5, end_us=0.6)

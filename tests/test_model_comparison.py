@@ -1,4 +1,4 @@
-"""The strength laws' evidence table (shockcal.model_comparison, `shockcal compare-models`)."""
+"""The strength laws' evidence table (shockcal.campaign.model_comparison, `shockcal compare-models`)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.box_sensitivity import BoxSensitivity
+from shockcal.campaign.box_sensitivity import BoxSensitivity
+from shockcal.campaign.model_comparison import COLUMNS, ModelResult, evidence_table
 from shockcal.errors import InputError
 from shockcal.io import write_table
-from shockcal.model_comparison import COLUMNS, ModelResult, evidence_table
 
 OBSERVED = (69.7, 199.4, 79.5, 186.4)
 BOX = BoxSensitivity(2, -46.0, 0.1, -47.5, 0.2)

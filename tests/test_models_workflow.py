@@ -13,8 +13,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from shockcal.model_comparison import COLUMNS
-from shockcal.release import RELEASE_COLUMNS
+from shockcal.campaign.model_comparison import COLUMNS
+from shockcal.campaign.release import RELEASE_COLUMNS
 
 REPO = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).parent / "snakemake")

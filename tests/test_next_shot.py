@@ -1,4 +1,4 @@
-"""The expected-information-gain estimator of `shockcal.next_shot` against truths it cannot tune to:
+"""The expected-information-gain estimator of `shockcal.campaign.next_shot` against truths it cannot tune to:
 the closed forms of a linear-Gaussian problem (full and marginal), quadrature on a nonlinear toy,
 the order of two designs, and bad input."""
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from shockcal.campaign.next_shot import expected_information_gain, noise_sd
 from shockcal.errors import InputError
-from shockcal.next_shot import expected_information_gain, noise_sd
 
 
 def _linear_problem():

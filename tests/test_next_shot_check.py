@@ -1,4 +1,4 @@
-"""The realized check of the next-shot ranking (issue 38; docs/next_shot.md, "The realized check"): the realized
+"""The realized check of the next-shot ranking (docs/next_shot.md, "The realized check"): the realized
 gain's yardstick on Gaussians, the summary and its verdict on known numbers, the truths (seeded, reproducible,
 inside the derived study's box), a candidate as a fourth shot added by config alone, the shared noise of the
 check's calibrations, and bad input. The target end to end is tests/test_workflow.py's."""
@@ -13,12 +13,12 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from shockcal.candidates import SHEAR_MODULUS, VELOCITY
+from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY
+from shockcal.campaign.next_shot import normal_scores
+from shockcal.campaign.next_shot_check import check_summary, check_table, realized_gain, truth_design, verdict
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import AL5083
-from shockcal.next_shot import normal_scores
-from shockcal.next_shot_check import check_summary, check_table, realized_gain, truth_design, verdict
 from shockcal.study.adapters import candidate, candidate_box, input_box, shot_mapping, study_design
 from shockcal.study.config import input_names, prior_bounds
 from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config
@@ -188,7 +188,7 @@ def test_truths_are_seeded_reproducible_and_inside_the_derived_box(paper_config,
 def test_truth_lambda_y_and_shared_noise_in_calibrate_check(paper_config):
     from test_calibration_check import FEATURES, ShotEmulator
 
-    from shockcal.coverage import HydroTruths, synthetic_truth
+    from shockcal.inference.coverage import HydroTruths, synthetic_truth
     from shockcal.study.adapters import calibration_settings
 
     paper_config["calibration"]["check"].update(n_live=100, n_eff=200)

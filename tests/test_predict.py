@@ -10,8 +10,8 @@ import pytest
 
 from shockcal.cli import main
 from shockcal.errors import InputError
+from shockcal.inference.predict import draw_posterior_design
 from shockcal.io import read_table, write_table
-from shockcal.predict import draw_posterior_design
 from shockcal.study.config import input_names
 
 CONFIG = str(Path(__file__).resolve().parents[1] / "config" / "config.yaml")
@@ -61,7 +61,7 @@ def test_cli_writes_the_design(paper_config, tmp_path, capsys):
 
 
 class _LinearEmulator:
-    """Stands in for shockcal.emulator.Emulator: features = 1e4 * V of the shot, sd 2 m/s."""
+    """Stands in for shockcal.emulator.study_emulator.Emulator: features = 1e4 * V of the shot, sd 2 m/s."""
 
     feature_names = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
     velocity = {"104S": "V1", "105S": "V2"}
@@ -73,7 +73,7 @@ class _LinearEmulator:
 
 
 def test_emulator_predictions_one_row_per_run_and_shot(paper_config):
-    from shockcal.predict import emulator_predictions
+    from shockcal.inference.predict import emulator_predictions
 
     design = draw_posterior_design(_posterior(paper_config, 50), input_names(paper_config), 10, seed=0)
     table = emulator_predictions(_LinearEmulator(), design, ["104S", "105S"])

@@ -49,16 +49,16 @@ def test_a_terminal_gets_tqdms_bar():
 
 
 def test_a_simulate_chunk_logs_its_progress(paper_config, caplog, monkeypatch):
-    from shockcal.design import latin_hypercube
-    from shockcal.simulate import simulate_design
+    from shockcal.design.tables import latin_hypercube
+    from shockcal.simulators.builtin import simulate_design
     from shockcal.study.adapters import hydro_inputs
     from shockcal.study.config import prior_bounds
 
     def no_hydrocode(*args):
         raise FloatingPointError("not run in this test")        # recorded as a failed run
 
-    monkeypatch.setattr("shockcal.simulate.run_shot", no_hydrocode)
-    caplog.set_level(logging.INFO, logger="shockcal.simulate")
+    monkeypatch.setattr("shockcal.simulators.builtin.run_shot", no_hydrocode)
+    caplog.set_level(logging.INFO, logger="shockcal.simulators.builtin")
     design = latin_hypercube(prior_bounds(paper_config), 3, seed=1)
     simulate_design(design, shot_mapping(paper_config, "104S"),
                     *hydro_inputs(paper_config, paper_config["shots"]["104S"]))
@@ -66,13 +66,13 @@ def test_a_simulate_chunk_logs_its_progress(paper_config, caplog, monkeypatch):
 
 
 def test_sampler_progress_lines_leave_the_draws_unchanged(caplog, monkeypatch):
-    from shockcal.sampler import nested_sample
+    from shockcal.inference.sampler import nested_sample
 
     def run():
         return nested_sample(lambda u: 4 * u - 2, lambda x: -0.5 * np.sum(x**2, axis=1) / 0.3**2, 2, n_live=100,
                              n_eff=300, seed=7)
 
-    caplog.set_level(logging.INFO, logger="shockcal.sampler")
+    caplog.set_level(logging.INFO, logger="shockcal.inference.sampler")
     quiet = run()
     assert not caplog.records                                   # shorter than 30 s: no line
     monkeypatch.setattr("shockcal.progress.LOG_INTERVAL_S", 0.0)

@@ -35,9 +35,9 @@ def test_readme_hydrocode_shot_is_the_study_configs_run(paper_config):
     """The two-line shot runs, its plateau is near the impact velocity (symmetric impact), and its defaults
     (Al-5083, the numerics) are the study config's: the same run through the config adapter is
     bit-identical, and so are its features read with the config's 104S settings."""
-    from shockcal.features import extract_features
     from shockcal.hydro import run_shot
     from shockcal.study.adapters import hydro_inputs
+    from shockcal.velocimetry.features import extract_features
 
     scope = _run_block(1)
     result = scope["result"]

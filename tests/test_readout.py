@@ -1,5 +1,5 @@
 """The robust read of noisy traces (isotonic monotone fit, local linear velocity reads over the noise
-window; shockcal.features), the record's noise model (shockcal.record_noise) and the read-out sd's
+window; shockcal.velocimetry.features), the record's noise model (shockcal.velocimetry.record_noise) and the read-out sd's
 parametric bootstrap, against known noise and brute-force Monte Carlo; the measured records under
 replicates of their own noise."""
 
@@ -10,7 +10,9 @@ import pytest
 from scipy.optimize import isotonic_regression
 from scipy.stats import norm
 
-from shockcal.features import (
+from shockcal.seeds import stream_seed
+from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.features import (
     CALIBRATION_FEATURES,
     extract,
     monotone_cdf,
@@ -18,10 +20,8 @@ from shockcal.features import (
     readout_replicates,
     readout_sd,
 )
-from shockcal.record_noise import NoiseModel, estimate_noise
-from shockcal.records import read_record
-from shockcal.seeds import stream_seed
-from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.record_noise import NoiseModel, estimate_noise
+from shockcal.velocimetry.records import read_record
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "al5083"
 T = np.arange(8001) * 0.0005                      # us: a 4 us record on a 0.5 ns grid
@@ -122,7 +122,7 @@ def test_bootstrap_sd_matches_brute_force_monte_carlo(bootstrap_and_brute_force,
 
 # The measured records under 20 replicates of their own noise (`readout_replicates`: the record's signal,
 # smoothed over its read-out window, plus the AR model fitted to its plateau, at its level and correlation;
-# seeds apart from the bootstrap's). Criterion, issue 36: every calibration velocity's mean shift from the
+# seeds apart from the bootstrap's). The criterion: every calibration velocity's mean shift from the
 # record's read and its spread within 0.3 of 1% of the feature. At the records' own correlated noise (sd
 # 0.67, 1.97, 2.38 m/s; 8-16 ns periods) no read reaches it: v_elastic and v_slope1 are quantiles of the
 # fitted mixture, and the noise moves the fit (v_slope1 spreads by 2-4% of itself). What is tested is the

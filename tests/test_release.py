@@ -1,4 +1,4 @@
-"""The release's arrival on a trace (shockcal.release) against synthetic traces whose release is known."""
+"""The release's arrival on a trace (shockcal.campaign.release) against synthetic traces whose release is known."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from shockcal.features import QUIET_ARRIVAL_FRACTION
-from shockcal.release import RELEASE_COLUMNS, predicted_releases_us, release_after_arrival_us, release_row
+from shockcal.campaign.release import RELEASE_COLUMNS, predicted_releases_us, release_after_arrival_us, release_row
+from shockcal.velocimetry.features import QUIET_ARRIVAL_FRACTION
 
 DT_US = 1.0e-4
 REPO = Path(__file__).resolve().parents[1]
@@ -88,7 +88,7 @@ def test_model_predictions_command(tmp_path):
     import subprocess
     import sys
 
-    from shockcal.records import read_record
+    from shockcal.velocimetry.records import read_record
 
     # the records' plastic plateaus as the extractor read them (results/quick/features/observed.parquet, 2026-11-26)
     shots = {"104S": (1.5667, 199.383), "105S": (2.6065, 358.816), "106S": (4.1035, 479.652)}

@@ -7,8 +7,8 @@ import pytest
 from scipy import stats
 
 from shockcal.errors import SamplerError
-from shockcal.sampler import SamplerSettings, WeightedDraws, nested_sample, pool, sample
-from shockcal.summaries import SUMMARY_QUANTILES, quantile_mcse_between, weighted_quantiles
+from shockcal.inference.sampler import SamplerSettings, WeightedDraws, nested_sample, pool, sample
+from shockcal.inference.summaries import SUMMARY_QUANTILES, quantile_mcse_between, weighted_quantiles
 
 
 def _box_transform(lower, upper):

@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
-from shockcal.design import latin_hypercube
+from shockcal.design.tables import latin_hypercube
 from shockcal.seeds import STREAMS, stream_seed
 from shockcal.study.config import prior_bounds
 

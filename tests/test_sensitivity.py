@@ -1,4 +1,4 @@
-"""Sobol indices (shockcal.sensitivity, SALib): the Ishigami function's known indices within the bootstrap
+"""Sobol indices (shockcal.campaign.sensitivity, SALib): the Ishigami function's known indices within the bootstrap
 intervals, the per-shot emulator wrapper on a model with known indices, and the one-line errors."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from shockcal.campaign.sensitivity import emulator_sobol, posterior_box, sobol_indices
 from shockcal.errors import InputError
-from shockcal.sensitivity import emulator_sobol, posterior_box, sobol_indices
 
 pytest.importorskip("SALib")
 

@@ -7,8 +7,8 @@ import yaml
 
 from shockcal import hydro
 from shockcal.cli import main
-from shockcal.design import latin_hypercube
-from shockcal.simulate import simulate_design
+from shockcal.design.tables import latin_hypercube
+from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import hydro_inputs, shot_mapping
 from shockcal.study.config import prior_bounds
 
@@ -44,7 +44,7 @@ def test_a_failing_run_is_recorded_and_the_batch_goes_on(coarse_config, monkeypa
         return real(params, *inputs)
 
     design = latin_hypercube(prior_bounds(config), 3, seed=2)
-    monkeypatch.setattr("shockcal.simulate.run_shot", flaky)
+    monkeypatch.setattr("shockcal.simulators.builtin.run_shot", flaky)
     table = simulate_design(design, shot_mapping(config, "104S"), *hydro_inputs(config, config["shots"]["104S"]))
     assert list(table["status"]) == ["ok", "failed", "ok"]
     assert "synthetic failure" in table["reason"].iloc[1]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from shockcal.stage_times import simulate_overhead, stage_table
+from shockcal.study.stage_times import simulate_overhead, stage_table
 
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
 

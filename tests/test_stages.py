@@ -1,5 +1,5 @@
 """shockcal.study.stages: one declaration of the config keys each stage reads, serving both the rules'
-params and the slice each command hands its library code (issue 15)."""
+params and the slice each command hands its library code."""
 from pathlib import Path
 
 import pytest

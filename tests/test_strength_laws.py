@@ -28,7 +28,8 @@ from shockcal.hydro.laws import LAWS, code_parameters, flow_stress_curve, get_la
 from shockcal.hydro.laws.boxes import load_boxes
 from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
 from shockcal.hydro.laws.steinberg_guinan import steinberg_guinan_melt_temperature, steinberg_guinan_shear_modulus
-from shockcal.hydro.solver import Material, homologous_temperature
+from shockcal.hydro.plastic_return import homologous_temperature
+from shockcal.hydro.state import Material
 from shockcal.hydro.strength import equivalent_strain_rate, flow_stress, hardening, thermal_factor
 
 RTOL = 1e-10

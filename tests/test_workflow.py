@@ -202,7 +202,7 @@ def params_changed(*config_files) -> set[str]:
 
 def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
     """Every stage that draws from a random stream of study.seed (shockcal.seeds) lists the seed in
-    its params, and no other does (issue 15's drift: the extractor once seeded from study.seed while
+    its params, and no other does (the drift this guards against: the extractor once seeded from study.seed while
     its rule did not list it). The design is fixed by a file so that only the seed differs."""
     results, config = study
     design = tmp_path / "design.parquet"

@@ -1,23 +1,26 @@
 """shockcal: Bayesian calibration of strength models from plate-impact velocimetry.
 
+The package is laid out as the method's stages, each a folder whose `__init__` says what it does and
+what it hands on (docs/architecture.md): `hydro` (the 1D hydrocode) and `simulators` (the run
+sources) -> `design` (which runs) -> `velocimetry` (records and features) -> `emulator` (PC-GP) ->
+`inference` (posteriors) -> `campaign` (which law, which shot next); `study` reads the config,
+`plots` draws the figures, `cli` holds the commands.
+
 The array API for notebooks (README, "From a notebook"): `PCGPEmulator` and its `EmulatorSettings`
 (fit, predict, cross-validate, save, load), `Problem` (a predictive model, measured features and a
 prior box), `SamplerSettings` and `sample` (the posterior). Imported on first use, so the command
 line starts without them.
 """
 
+from shockcal._lazy import lazy_exports
+
 __version__ = "0.1.0"
 
-_API = {"PCGPEmulator": ("shockcal.emulator", "PCGPEmulator"), "EmulatorSettings": ("shockcal.emulator", "Settings"),
-        "Problem": ("shockcal.calibration", "Problem"), "SamplerSettings": ("shockcal.calibration", "SamplerSettings"),
-        "sample": ("shockcal.calibration", "sample")}
-__all__ = list(_API)
-
-
-def __getattr__(name: str):
-    if name not in _API:
-        raise AttributeError(f"module 'shockcal' has no attribute {name!r}")
-    import importlib
-
-    module, attribute = _API[name]
-    return getattr(importlib.import_module(module), attribute)
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "PCGPEmulator": "shockcal.emulator.pcgp",
+    "EmulatorSettings": "shockcal.emulator.pcgp:Settings",
+    "Problem": "shockcal.inference.problem",
+    "SamplerSettings": "shockcal.inference.sampler",
+    "sample": "shockcal.inference.sampler",
+    "Posterior": "shockcal.inference.sampler",
+})

@@ -1,6 +1,6 @@
 """Plausibility of units and ranges: a value in the wrong unit stops with a message, not a wrong answer.
 
-A design point outside the prior box (shockcal.design), a VISAR record (shockcal.records) or observed
+A design point outside the prior box (shockcal.design.tables), a VISAR record (shockcal.velocimetry.records) or observed
 features (config values, the table calibration reads) whose magnitudes fit another unit better than
 the one shockcal reads them in, and a plastic plateau that does not fit its shot's impact velocity
 (`check_plateau`: the records or features of two shots swapped): each check names the file, key or row, what looks wrong, the unit

@@ -7,7 +7,7 @@ Where it goes depends on stderr:
   ordinary log line of the caller's logger, at most once every `LOG_INTERVAL_S` seconds, plus one
   line when the loop starts and one when it ends, e.g.
 
-      2026-11-26 10:00:31,402 shockcal.simulate INFO: shot 104S: 60/150 runs (40%), 01:02 elapsed, 01:33 left, 1.55s/run
+      2026-11-26 10:00:31,402 shockcal.simulators.builtin INFO: shot 104S: 60/150 runs (40%), 01:02 elapsed, 01:33 left, 1.55s/run
 
   A simulate job of 150 runs (1.5-3.5 min) gets 5 to 9 such lines, a job of 10 check trials (~16 min)
   one per trial; without logging configured at INFO (a notebook) nothing is shown.

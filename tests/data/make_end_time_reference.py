@@ -2,7 +2,7 @@
 
 The set: three seeded Latin-hypercube points per shot and two corners of the prior box where the
 free surface moves latest (small A, B, G and impact velocity; strong thermal softening). Made with
-the rate convention of issue 12, the exact-CDF extractor (2026-11-25; it moved one corner run's
+the total-rate convention that reproduces FLAG, the exact-CDF extractor (2026-11-25; it moved one corner run's
 v_elastic by 2.9 m/s, a near-tie of EM optima) and `hydro.end_time_us: 4.0`; `tests/test_end_time.py` checks that
 `end_time_us: auto` reproduces these features within 0.05 m/s (and 0.5 ns).
 Run: python tests/data/make_end_time_reference.py
@@ -13,12 +13,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from shockcal.design import latin_hypercube
-from shockcal.features import features_table
-from shockcal.simulate import simulate_design
+from shockcal.design.tables import latin_hypercube
+from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.config import prior_bounds
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.features import features_table
 
 REPO = Path(__file__).resolve().parents[2]
 OUT = Path(__file__).with_name("end_time_reference.csv")

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.sampler import WeightedDraws
+from shockcal.inference.sampler import WeightedDraws
 
 REPO = Path(__file__).resolve().parents[2]
 SOURCE = REPO / "benchmarks/out/reference_published_t/reference_joint.parquet"

@@ -5,12 +5,12 @@ import sys
 
 import yaml
 
-from shockcal.design import chunk_fingerprints, write_design
+from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
 from shockcal.study.next_shot_check import plan_check
 from shockcal.study.stages import figure_config, stage_config
-from shockcal.workflow import (
+from shockcal.study.workflow import (
     chunk_count,
     chunk_rows,
     export_to_jobs,

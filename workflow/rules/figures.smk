@@ -1,4 +1,4 @@
-# The paper's fifteen figures (issue 7) and the study's own (Sobol indices), one rule per figure, each `shockcal figures --figure NAME`
+# The paper's fifteen figures and the study's own (Sobol indices), one rule per figure, each `shockcal figures --figure NAME`
 # with its inputs passed as KEY=PATH pairs. PNG and PDF (figures.formats) under {RESULTS}/figures/;
 # the PNG goes into the report with a caption from workflow/report/. The figures, their categories
 # and the input keys each needs come from the catalogue (shockcal.plots.catalogue); this file only

@@ -1,4 +1,4 @@
-# Which shot next (issue 38; docs/next_shot.md): each next-shot candidate's design (next_shot.n_draws
+# Which shot next (docs/next_shot.md): each next-shot candidate's design (next_shot.n_draws
 # joint-posterior draws at its conditions), run as the run set "next_shot" through simulate.smk and
 # features.smk (the candidate's name in the shot's place, chunks of simulate.chunk_size runs), and the
 # ranking of the candidates by expected information gain. Outside `all`: `make next-shot`

@@ -1,4 +1,4 @@
-# The realized check of the next-shot ranking (issue 38; docs/next_shot.md, "The realized check"): each compared
+# The realized check of the next-shot ranking (docs/next_shot.md, "The realized check"): each compared
 # candidate (design.smk's CHECK_PLANS) as the fourth shot of a derived study, its training runs (run set
 # next_shot_check) and the truths' runs at every shot (run set next_shot_truth) through simulate.smk and
 # features.smk; an emulator on the first next_shot.check.n_training_runs rows of the three shots (baseline) and of

@@ -51,7 +51,7 @@ def register(subparsers) -> None:
 def study_emulator(directory, config: dict):
     """The emulator in `directory`, checked against the study's shot mappings and prior box
     (`Emulator.check_study`)."""
-    from shockcal.emulator import Emulator
+    from shockcal.emulator.study_emulator import Emulator
     from shockcal.study.adapters import shot_mapping
     from shockcal.study.config import prior_bounds
 
@@ -72,7 +72,7 @@ def companion_path(out, kind: str = "summary"):
 def run(args) -> int:
     import logging
 
-    from shockcal.calibration import calibrate
+    from shockcal.inference.calibration import calibrate
     from shockcal.io import read_table, write_table
     from shockcal.study.adapters import calibration_settings
     from shockcal.study.stages import load_stage_config
@@ -106,8 +106,8 @@ def run(args) -> int:
 def run_check(args) -> int:
     import logging
 
-    from shockcal.coverage import coverage_table, synthetic_truth
     from shockcal.errors import InputError
+    from shockcal.inference.coverage import coverage_table, synthetic_truth
     from shockcal.io import write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import calibration_settings
@@ -116,7 +116,7 @@ def run_check(args) -> int:
     config = load_stage_config(args.config, "calibrate_check")
     unique_shots(args.shots)
     if not getattr(args, "verbose", False):   # the batch's progress line (count, time left) says enough; each trial's sampler lines: -v
-        logging.getLogger("shockcal.sampler").setLevel(logging.WARNING)
+        logging.getLogger("shockcal.inference.sampler").setLevel(logging.WARNING)
     truths = hydro_truths(args)
     emulator = study_emulator(args.emulator, config)
     truth = "emulator" if truths is None else "hydrocode"
@@ -147,7 +147,7 @@ def run_check(args) -> int:
 
 
 def run_coverage(args) -> int:
-    from shockcal.coverage import coverage_table
+    from shockcal.inference.coverage import coverage_table
     from shockcal.io import read_tables, write_table
 
     table = read_tables(args.trials, ["trial", "parameter"], "per-trial")
@@ -160,7 +160,7 @@ def log_coverage(coverage, trials) -> None:
     """Log the per-parameter coverage and, when the trials carry it, the joint check (`joint_coverage`)."""
     import logging
 
-    from shockcal.coverage import coverage_by_fifth, joint_coverage, usable_trials
+    from shockcal.inference.coverage import coverage_by_fifth, joint_coverage, usable_trials
 
     log = logging.getLogger("shockcal.calibrate")
     if "status" in trials:
@@ -191,8 +191,8 @@ def trial_range(text: str | None) -> range | None:
 
 def hydro_truths(args):
     """The hydrocode truth runs named on the command line, or None (emulator truth)."""
-    from shockcal.coverage import HydroTruths
     from shockcal.errors import InputError
+    from shockcal.inference.coverage import HydroTruths
 
     if not args.truth_design and not args.truth_features:
         return None

@@ -5,7 +5,7 @@ log evidence and its sd, the measured features), RESULTS_DIR/posterior/joint_wei
 sampler's weighted draws, for the box sensitivity), RESULTS_DIR/emulator/emulator.json's input_bounds
 (the prior box the calibration used) and RESULTS_DIR/emulator/cv_rmse.csv (the K-fold and outer check's
 RMSE over all shots and features; the outer one empty when the emulator skipped it).
-Writes `--out` (CSV; shockcal.model_comparison.COLUMNS) and, with `--figures-dir`, the log evidence per law
+Writes `--out` (CSV; shockcal.campaign.model_comparison.COLUMNS) and, with `--figures-dir`, the log evidence per law
 (evidence.png and .pdf).
 
 The box parameters are the calibrated inputs except the shots' impact velocities (the inputs in cm/us,
@@ -36,9 +36,9 @@ def model_result(name: str, results_dir: str):
 
     import pandas as pd
 
+    from shockcal.campaign.model_comparison import ModelResult
     from shockcal.errors import InputError
     from shockcal.io import read_table_metadata
-    from shockcal.model_comparison import ModelResult
 
     posterior = Path(results_dir) / "posterior" / "joint.parquet"
     weighted = Path(results_dir) / "posterior" / "joint_weighted.parquet"
@@ -69,17 +69,17 @@ VELOCITY_UNIT = "cm/us"      # a shot's velocity_input (config schema): excluded
 
 
 def box_result(name: str, weighted_path, emulator_path):
-    """The evidence's sensitivity to the box of one law's study (`shockcal.box_sensitivity`) from its weighted
+    """The evidence's sensitivity to the box of one law's study (`shockcal.campaign.box_sensitivity`) from its weighted
     draws and its emulator's input bounds; InputError naming the file and key that is missing."""
     import json
     from pathlib import Path
 
     import numpy as np
 
-    from shockcal.box_sensitivity import box_sensitivity
+    from shockcal.campaign.box_sensitivity import box_sensitivity
     from shockcal.errors import InputError
+    from shockcal.inference.sampler import WeightedDraws
     from shockcal.io import read_table, read_table_metadata, require_columns
-    from shockcal.sampler import WeightedDraws
 
     meta = read_table_metadata(weighted_path)
     for key in ("parameters", "units", "log_evidence", "log_evidence_sd"):
@@ -106,8 +106,8 @@ def run(args) -> int:
     import logging
     from pathlib import Path
 
+    from shockcal.campaign.model_comparison import evidence_table
     from shockcal.cli import parse_model_dirs
-    from shockcal.model_comparison import evidence_table
 
     results = {law: model_result(law, results_dir) for law, results_dir in parse_model_dirs(args.model).items()}
     table = evidence_table(results)

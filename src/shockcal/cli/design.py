@@ -22,7 +22,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.design import write_design
+    from shockcal.design.tables import write_design
     from shockcal.study.adapters import input_box, study_design
     from shockcal.study.stages import load_stage_config
 
@@ -33,5 +33,5 @@ def run(args) -> int:
         n_runs, lhs = args.n_runs, args.lhs
     design, source = study_design(config, n_runs, args.seed, args.stream, lhs)
     write_design(design, source, input_box(config), args.out)
-    logging.getLogger("shockcal.design").info("wrote %d runs (%s) to %s", len(design), source, args.out)
+    logging.getLogger("shockcal.design.tables").info("wrote %d runs (%s) to %s", len(design), source, args.out)
     return 0

@@ -40,7 +40,7 @@ def run(args) -> int:
     from dataclasses import replace
     from pathlib import Path
 
-    from shockcal.emulator import fit_emulator
+    from shockcal.emulator.study_emulator import fit_emulator
     from shockcal.io import read_table
     from shockcal.study.adapters import emulator_spec, load_study_design
     from shockcal.study.stages import load_stage_config
@@ -74,7 +74,7 @@ def write_cv(emulator, out, schemes, folds: int, margin: float):
     """Write cv.parquet (closed-form LOO) and/or cv_heldout.parquet (K-fold, outer); return the RMSE table."""
     import pandas as pd
 
-    from shockcal.emulator import rmse_table
+    from shockcal.emulator.study_emulator import rmse_table
     from shockcal.io import read_table, write_table
 
     if "loo_closed_form" in schemes:
@@ -96,7 +96,7 @@ def print_cv(args) -> int:
 
     import pandas as pd
 
-    from shockcal.emulator import Emulator, rmse_table
+    from shockcal.emulator.study_emulator import Emulator, rmse_table
     from shockcal.io import read_table
 
     out = Path(args.emulator)

@@ -6,7 +6,7 @@ import logging
 
 from shockcal.cli import add_config_argument
 
-log = logging.getLogger("shockcal.features")
+log = logging.getLogger("shockcal.velocimetry.features")
 UNITS = {"t_*": "us", "v_*": "m/s", "readout_sd_v_*": "m/s", "noise_sd_m_s": "m/s", "readout_half_window_ns": "ns"}
 
 
@@ -36,11 +36,11 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import pandas as pd
 
-    from shockcal.features import check_failures, record_features
     from shockcal.io import write_table
     from shockcal.study.adapters import candidate_extractor_settings, extractor_settings
     from shockcal.study.config import candidate_config
     from shockcal.study.stages import is_candidate, load_stage_config
+    from shockcal.velocimetry.features import check_failures, record_features
 
     name = args.shot
     candidate = is_candidate(args.config, name)
@@ -52,8 +52,8 @@ def run(args) -> int:
                                **record_features(args.record, settings, name, args.time_column,
                                                  args.velocity_column)}])
     else:
-        from shockcal.features import features_table
         from shockcal.io import read_tables
+        from shockcal.velocimetry.features import features_table
 
         if args.tables:
             table = read_tables(args.tables, ["run"], "features")

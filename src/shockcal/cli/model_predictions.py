@@ -1,11 +1,11 @@
 """`shockcal model-predictions`: each strength law's posterior predictive runs past the analysis window: the
-release's arrival per law and shot (`shockcal.release`) and one figure page per law.
+release's arrival per law and shot (`shockcal.campaign.release`) and one figure page per law.
 
 Reads, per `--model NAME=RESULTS_DIR`: RESULTS_DIR/features/observed.parquet (each record's t_plastic and
 v_plastic), RESULTS_DIR/predict/simulations/<shot>/chunk-*.parquet (the joint posterior's draws through the
 hydrocode over the whole record, `predict.end_time_us`) and RESULTS_DIR/predict/features/<shot>.parquet;
 from `--config` the shots, their records (`observed.records`) and analysis windows.
-Writes `--out` (CSV; shockcal.release.RELEASE_COLUMNS) and, with `--figures-dir`, predictive_<law>.png/.pdf.
+Writes `--out` (CSV; shockcal.campaign.release.RELEASE_COLUMNS) and, with `--figures-dir`, predictive_<law>.png/.pdf.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="the release table (CSV), e.g. results/models/release.csv")
     p.add_argument("--figures-dir", default=None, help="where predictive_<law>.png and .pdf go")
     p.add_argument("--margin-m-s", type=float, default=None,
-                   help="how far below the plastic plateau a release starts (m/s; default shockcal.release's 20)")
+                   help="how far below the plastic plateau a release starts (m/s; default shockcal.campaign.release's 20)")
     p.set_defaults(func=run)
 
 
@@ -41,10 +41,10 @@ def law_predictions(name: str, results_dir: str, config: dict, margin_m_s: float
 
     import pandas as pd
 
+    from shockcal.campaign.release import predicted_releases_us, release_after_arrival_us, release_row
     from shockcal.io import read_table, require_columns
     from shockcal.plots.models import ShotPredictions
-    from shockcal.records import read_record
-    from shockcal.release import predicted_releases_us, release_after_arrival_us, release_row
+    from shockcal.velocimetry.records import read_record
 
     root = Path(results_dir)
     observed = read_table(_required(root / "features" / "observed.parquet", name))
@@ -76,9 +76,9 @@ def run(args) -> int:
 
     import pandas as pd
 
+    from shockcal.campaign.release import RELEASE_COLUMNS, RELEASE_MARGIN_M_S
     from shockcal.cli import parse_model_dirs
     from shockcal.errors import InputError
-    from shockcal.release import RELEASE_COLUMNS, RELEASE_MARGIN_M_S
     from shockcal.study.validate import load_config
 
     config = load_config(args.config)

@@ -1,7 +1,7 @@
-"""`shockcal next-shot-design` and `shockcal suggest-shot`: which shot next (issue 38, docs/next_shot.md).
+"""`shockcal next-shot-design` and `shockcal suggest-shot`: which shot next (docs/next_shot.md).
 
 next-shot-design reads the joint posterior's equal-weight draws and writes one candidate's design
-(`shockcal.candidates.candidate_design`: next_shot.n_draws draws, stream next_shot "draws", the same rows
+(`shockcal.campaign.candidates.candidate_design`: next_shot.n_draws draws, stream next_shot "draws", the same rows
 for every candidate), after checking that the candidate's waves split (`check_split`); its runs go
 through `shockcal simulate --candidate` and `shockcal features --candidate`.
 suggest-shot reads every candidate's design and features and writes the ranking (CSV): per candidate
@@ -44,7 +44,7 @@ def register(subparsers) -> None:
 def run_design(args) -> int:
     import logging
 
-    from shockcal.candidates import candidate_design, check_split
+    from shockcal.campaign.candidates import candidate_design, check_split
     from shockcal.errors import InputError
     from shockcal.io import read_table, read_table_metadata, write_table
     from shockcal.seeds import stream_seed
@@ -71,7 +71,7 @@ def run_design(args) -> int:
                                    "source": f"joint posterior draws from {args.posterior}, seed {seed}",
                                    "units": {**units, "velocity_cm_us": "cm/us", "shear_modulus_Mbar": "Mbar",
                                              "shear_modulus_log_slope_per_K": "1/K"}})
-    logging.getLogger("shockcal.next_shot").info("candidate %s: %d posterior draws (seed %d) -> %s", args.candidate,
+    logging.getLogger("shockcal.campaign.next_shot").info("candidate %s: %d posterior draws (seed %d) -> %s", args.candidate,
                                                  len(design), seed, args.out)
     return 0
 
@@ -101,7 +101,7 @@ def candidate_readout_sd(given: dict, observed, shot: str, features, source: str
     import numpy as np
 
     from shockcal.errors import InputError
-    from shockcal.problem import readout_vector
+    from shockcal.inference.problem import readout_vector
 
     if observed is None:
         reference = np.zeros(len(features))
@@ -118,14 +118,14 @@ def run_suggest(args) -> int:
 
     import numpy as np
 
-    from shockcal.candidates import SLOPE, VELOCITY_FACTOR, check_design, ranking_table, score_candidate
+    from shockcal.campaign.candidates import SLOPE, VELOCITY_FACTOR, check_design, ranking_table, score_candidate
     from shockcal.errors import InputError
-    from shockcal.features import CALIBRATION_FEATURES
     from shockcal.io import atomic_path, read_table
     from shockcal.seeds import stream_seed
     from shockcal.study.config import input_names
     from shockcal.study.stages import load_stage_config
     from shockcal.study.strength import next_shot_targets
+    from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     config = load_stage_config(args.config, "suggest_shot")
     section = config["next_shot"]
@@ -143,7 +143,7 @@ def run_suggest(args) -> int:
         raise InputError("next_shot.emulator_error is true: give the emulator's RMSE table (--emulator-rmse "
                          "results/emulator/cv_rmse.csv), or set it to false")
     rmse = read_table(args.emulator_rmse) if section["emulator_error"] else None
-    log = logging.getLogger("shockcal.next_shot")
+    log = logging.getLogger("shockcal.campaign.next_shot")
     targets = next_shot_targets(config)
     rows = []
     for name, spec in section["candidates"].items():

@@ -1,8 +1,8 @@
 """`shockcal next-shot-check-truths` and `shockcal next-shot-check-summary`: the realized check of the
-next-shot ranking (issue 38, docs/next_shot.md "The realized check").
+next-shot ranking (docs/next_shot.md "The realized check").
 
 next-shot-check-truths draws next_shot.check.n_truths rows of the joint posterior (stream next_shot
-"check_truths") as the truths of every compared candidate (`shockcal.next_shot_check.truth_design`): the
+"check_truths") as the truths of every compared candidate (`shockcal.campaign.next_shot_check.truth_design`): the
 study's inputs, lambda_y, and each candidate's velocity and shear-modulus increment as its fourth shot
 reads them (`shockcal.study.next_shot_check`). Their runs go through `shockcal simulate` and `features`,
 their calibrations through `shockcal calibrate-check --truth-design ... --draws-out`.
@@ -44,9 +44,9 @@ def register(subparsers) -> None:
 def run_truths(args) -> int:
     import logging
 
+    from shockcal.campaign.next_shot_check import truth_design
     from shockcal.errors import InputError
     from shockcal.io import read_table, write_table
-    from shockcal.next_shot_check import truth_design
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import candidate, material_properties
     from shockcal.study.config import input_names, prior_bounds
@@ -73,7 +73,7 @@ def run_truths(args) -> int:
              **{increment: "Mbar" for _, _, increment in candidates.values() if increment}}
     write_table(design, args.out, {"table": "design", "run_set": "next-shot check truths", "units": units,
                                    "source": f"joint posterior draws from {args.posterior}, seed {seed}"})
-    logging.getLogger("shockcal.next_shot").info("next-shot check: %d truths (seed %d) for %s -> %s", len(design), seed,
+    logging.getLogger("shockcal.campaign.next_shot").info("next-shot check: %d truths (seed %d) for %s -> %s", len(design), seed,
                                                  ", ".join(args.candidates), args.out)
     return 0
 
@@ -84,9 +84,9 @@ def run_summary(args) -> int:
 
     import pandas as pd
 
+    from shockcal.campaign.next_shot_check import check_summary, check_table
     from shockcal.errors import InputError
     from shockcal.io import atomic_path, read_table, require_columns
-    from shockcal.next_shot_check import check_summary, check_table
     from shockcal.study.stages import load_stage_config
     from shockcal.study.strength import next_shot_targets
 
@@ -114,6 +114,6 @@ def run_summary(args) -> int:
     for table, path in ((check, out), (summary, out.with_name(f"{out.stem}_summary.csv"))):
         with atomic_path(path) as tmp:
             table.to_csv(tmp, index=False, float_format="%.6g")
-    logging.getLogger("shockcal.next_shot").info("next-shot check, %s against %s over %d truths:\n%s", best, worst,
+    logging.getLogger("shockcal.campaign.next_shot").info("next-shot check, %s against %s over %d truths:\n%s", best, worst,
                                                  check["run"].nunique(), summary.to_string(index=False))
     return 0

@@ -3,7 +3,7 @@
 Reads the posterior written by `shockcal calibrate` (the equal-weight draws, the weighted draws beside
 them, their metadata: shots, measured features and their sd, units, sampler settings, evidence) and,
 for the joint posterior, the features of the hydrocode runs at its draws; writes OUT (.nc) with the
-groups of `shockcal.inference_data`. Config keys: the `calibrate` stage's (the prior box; their
+groups of `shockcal.inference.inference_data`. Config keys: the `calibrate` stage's (the prior box; their
 sha256 is the file's `config_digest`).
 """
 
@@ -30,7 +30,7 @@ def run(args) -> int:
     from shockcal import __version__
     from shockcal.cli.calibrate import companion_path
     from shockcal.errors import InputError
-    from shockcal.inference_data import (
+    from shockcal.inference.inference_data import (
         config_digest,
         git_commit,
         observed_frames,

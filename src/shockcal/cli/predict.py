@@ -26,8 +26,8 @@ def run(args) -> int:
     import logging
 
     from shockcal.errors import InputError
+    from shockcal.inference.predict import draw_posterior_design
     from shockcal.io import read_table, read_table_metadata, write_table
-    from shockcal.predict import draw_posterior_design
     from shockcal.seeds import stream_seed
     from shockcal.study.config import input_names, prior_bounds
     from shockcal.study.stages import load_stage_config
@@ -45,7 +45,7 @@ def run(args) -> int:
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})
-    logging.getLogger("shockcal.predict").info("wrote %d posterior draws (seed %d) to %s", len(design), seed, args.out)
+    logging.getLogger("shockcal.inference.predict").info("wrote %d posterior draws (seed %d) to %s", len(design), seed, args.out)
     return 0
 
 
@@ -53,8 +53,8 @@ def run_emulator(args) -> int:
     import logging
 
     from shockcal.cli.calibrate import study_emulator
+    from shockcal.inference.predict import emulator_predictions
     from shockcal.io import write_table
-    from shockcal.predict import emulator_predictions
     from shockcal.study.adapters import load_study_design
     from shockcal.study.stages import load_stage_config
 
@@ -66,6 +66,6 @@ def run_emulator(args) -> int:
     table = emulator_predictions(emulator, design, shots)
     write_table(table, args.out, {"table": "emulator_predictions", "design": args.design, "emulator": args.emulator,
                                   "units": "m/s"})
-    logging.getLogger("shockcal.predict").info("wrote emulator predictions for %d runs x %d shots to %s",
+    logging.getLogger("shockcal.inference.predict").info("wrote emulator predictions for %d runs x %d shots to %s",
                                                len(design), len(shots), args.out)
     return 0

@@ -55,7 +55,7 @@ def run(args) -> int:
     import pandas as pd
 
     from shockcal.cli.calibrate import companion_path
-    from shockcal.coverage import coverage_table
+    from shockcal.inference.coverage import coverage_table
     from shockcal.io import read_table, read_table_metadata
 
     out = Path(args.out_dir)

@@ -1,5 +1,5 @@
 """`shockcal sensitivity`: Sobol indices of the emulated calibration features (SALib), over the prior box
-and over the box of the joint posterior's 5-95% quantiles (shockcal.sensitivity says why a box).
+and over the box of the joint posterior's 5-95% quantiles (shockcal.campaign.sensitivity says why a box).
 
 Config keys: `sensitivity` (n_base, resamples), `inputs` (the prior box), study.seed (the
 `sensitivity` stream)."""
@@ -28,10 +28,10 @@ def run(args) -> int:
 
     import pandas as pd
 
-    from shockcal.emulator import Emulator
+    from shockcal.campaign.sensitivity import emulator_sobol, posterior_box
+    from shockcal.emulator.study_emulator import Emulator
     from shockcal.io import atomic_path, read_table, write_table
     from shockcal.seeds import stream_seed
-    from shockcal.sensitivity import emulator_sobol, posterior_box
     from shockcal.study.config import prior_bounds
     from shockcal.study.stages import load_stage_config
 
@@ -45,7 +45,7 @@ def run(args) -> int:
     if args.posterior_summary:
         names = [k for k in prior if k in emulator.required_inputs(emulator.shots)]
         domains["posterior_q05_q95"] = posterior_box(read_table(args.posterior_summary), names)
-    log = logging.getLogger("shockcal.sensitivity")
+    log = logging.getLogger("shockcal.campaign.sensitivity")
     parts = []
     for domain, bounds in domains.items():
         start = time.perf_counter()

@@ -21,10 +21,10 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
-    from shockcal.design import load_design
+    from shockcal.design.tables import load_design
     from shockcal.errors import InputError
     from shockcal.io import write_table
-    from shockcal.simulate import UNITS, simulate_design
+    from shockcal.simulators.builtin import UNITS, simulate_design
     from shockcal.study.adapters import candidate, candidate_box, hydro_inputs, input_box, shot_mapping
     from shockcal.study.config import candidate_config, shot_config
     from shockcal.study.stages import is_candidate, load_stage_config
@@ -47,7 +47,7 @@ def run(args) -> int:
     write_table(table, args.out, {"table": "simulations", "shot": name, "units": units,
                                   "hydro": config["hydro"], "material": config["material"]})
     failed = int((table["status"] != "ok").sum()) if len(table) else 0
-    logging.getLogger("shockcal.simulate").info("shot %s: %d runs, %d failed, %.1f s of hydrocode -> %s", name,
+    logging.getLogger("shockcal.simulators.builtin").info("shot %s: %d runs, %d failed, %.1f s of hydrocode -> %s", name,
                                                 len(table), failed, table["wall_time_s"].sum() if len(table) else 0.0,
                                                 args.out)
     return 0

@@ -13,7 +13,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from shockcal.errors import InputError
-    from shockcal.stage_times import simulate_overhead, stage_table
+    from shockcal.study.stage_times import simulate_overhead, stage_table
 
     if not Path(args.benchmarks).is_dir():
         raise InputError(f"{args.benchmarks}: no such folder (run the study first)")

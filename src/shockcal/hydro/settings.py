@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
-from shockcal.hydro.solver import InitialState, Material, Numerics
+from shockcal.hydro.state import InitialState, Material, Numerics
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 

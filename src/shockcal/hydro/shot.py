@@ -18,7 +18,8 @@ import numpy as np
 
 from shockcal.hydro.parameters import LawShotParameters, ShotParameters
 from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
-from shockcal.hydro.solver import FAILURE_REASONS, STATUS_OK, LawStrength, Strength, simulate
+from shockcal.hydro.solver import simulate
+from shockcal.hydro.state import FAILURE_REASONS, STATUS_OK, LawStrength, Strength
 from shockcal.units import CM_US_TO_M_S, UM_TO_CM
 
 

@@ -24,12 +24,12 @@ rear node nf and the target's front node nf+1. Both outer nodes are free surface
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
    only), the cell's shear modulus, elastic trial deviator and radial return onto the strength law
-   (`plastic_return`: Johnson-Cook's skipped while the trial lies inside the cell's flow-stress floor,
+   (`shockcal.hydro.plastic_return`: Johnson-Cook's skipped while the trial lies inside the cell's flow-stress floor,
    `floor_at`, `new_floors`; any other law's evaluated every step), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
-(`Material`, `Strength` for Johnson-Cook or `LawStrength` for any law, `Numerics`; `shockcal.units`
+(`shockcal.hydro.state`: `Material`, `Strength` for Johnson-Cook or `LawStrength` for any law, `Numerics`; `shockcal.units`
 converts); numba compiles the kernels once per strength tuple type. Kernels that loop over the mesh
 take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
@@ -42,129 +42,24 @@ physics, a little more work.)
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from shockcal.hydro.eos import bulk_sound_speed_sq, cold_pressure
-from shockcal.hydro.laws.kernels import law_flow_stress, law_shear_modulus
-from shockcal.hydro.strength import (
-    equivalent_strain_rate,
-    flow_stress,
-    hardening,
-    radial_return,
-    rate_factor,
-    thermal_factor,
-    thermal_factor_below,
+from shockcal.hydro.plastic_return import cell_shear_modulus, initial_hardening, plastic_return
+from shockcal.hydro.state import (
+    STATUS_DT_COLLAPSE,
+    STATUS_NAN,
+    STATUS_NEGATIVE_VOLUME,
+    STATUS_OK,
+    Cells,
+    KernelResult,
+    Nodes,
 )
 
-STATUS_OK, STATUS_NEGATIVE_VOLUME, STATUS_NAN, STATUS_DT_COLLAPSE = 0, 1, 2, 3
-FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "NaN in cell state",
-                   STATUS_DT_COLLAPSE: "time step collapsed"}
 DT_FLOOR_US = 1.0e-12
-FLOOR_MARGIN_K = 1.0       # a cell's flow-stress floor holds up to this much above the temperature it was set at
-FLOOR_SLACK = 1.0 - 1e-12  # keeps the floor below the flow stress through rounding (products in another order)
 DT_GROWTH = 1.1            # the time step grows by at most 10% a step
-
-
-class Material(NamedTuple):
-    """Flyer and target material: Mie-Grueneisen EOS and thermal constants (code units)."""
-
-    rho0: float            # g/cc
-    c1: float              # Mbar
-    c2: float              # Mbar
-    c3: float              # Mbar
-    gamma0: float
-    T_ref: float           # K
-    T_melt: float          # K
-    cv: float              # (cm/us)^2 / K
-
-
-class InitialState(NamedTuple):
-    """Both plates before impact: at rest, at zero pressure, at the shot's initial temperature (code
-    units). At T_ref: rho = rho0, E = 0; hotter, E = cv (T0 - T_ref) and rho solves P(rho, E) = 0
-    (`MaterialProperties.initial_state`)."""
-
-    rho: float             # g/cc
-    E: float               # specific internal energy, (cm/us)^2
-
-
-class Strength(NamedTuple):
-    """Shear modulus and Johnson-Cook parameters of one run (Mbar, -, 1/us)."""
-
-    G: float
-    A: float
-    B: float
-    C: float
-    n: float
-    m: float
-    rate_ref: float
-
-
-class LawStrength(NamedTuple):
-    """Any strength law of `shockcal.hydro.laws` in one run: its named tuple in code units and the
-    shot's shear modulus G (Mbar), used only by laws without a shear-modulus law of their own
-    (Johnson-Cook, Zerilli-Armstrong). numba compiles the kernels once per law tuple type."""
-
-    law: tuple
-    G: float
-
-
-class Numerics(NamedTuple):
-    """Artificial viscosity and time stepping (us)."""
-
-    q1: float
-    q2: float
-    cfl: float
-    dt_initial: float
-    dt_max: float
-
-
-class KernelResult(NamedTuple):
-    """What `simulate` returns (code units: cm/us, Mbar cm, us, K)."""
-
-    v_free_surface: np.ndarray   # target's free-surface velocity at t_out, cm/us
-    energy: np.ndarray           # total energy per unit area at t_out (zero past a failure), Mbar cm
-    status: int                  # STATUS_OK or a failure code (FAILURE_REASONS)
-    fail_cell: int               # the failed cell, or -1
-    fail_time: float             # us
-    n_steps: int
-    max_plastic_rate: float      # 1/us, over the target's cells
-    max_temperature: float       # K
-    max_plastic_strain: float
-
-
-class Nodes(NamedTuple):
-    """Node velocity (cm/us) and lumped mass per unit area (g/cm^2), nodes 0..N+1."""
-
-    u: np.ndarray
-    mass: np.ndarray
-
-
-class Cells(NamedTuple):
-    """Cell state, cells 0..N (cell `gap` is the contact gap: no mass, its length is the gap).
-
-    `flow_floor` is a lower bound of the cell's rate-free flow stress (A + B eps_p^n)(1 - T*^m),
-    valid while its temperature stays at or below `floor_T`, the temperature of its last full
-    evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
-    is one valid up to `FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
-    so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
-    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. `hard` and
-    the floors are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused."""
-
-    mass: np.ndarray       # g/cm^2
-    length: np.ndarray     # cm
-    E: np.ndarray          # specific internal energy, (cm/us)^2
-    P: np.ndarray          # pressure, Mbar
-    s: np.ndarray          # deviator s_xx, Mbar
-    sigma: np.ndarray      # total stress -(P + q) + s, Mbar
-    eps_p: np.ndarray      # equivalent plastic strain
-    hard: np.ndarray       # A + B eps_p^n, Mbar
-    flow_floor: np.ndarray  # Mbar
-    floor_hotter: np.ndarray  # Mbar
-    floor_T: np.ndarray    # K
 
 
 @njit(cache=True, error_model="numpy")
@@ -253,127 +148,6 @@ def signal_speed(du, c_long, q1, q2):
         a_visc = q1 * c_long + 2.0 * q2 * abs(du)
         return a_visc + math.sqrt(a_visc * a_visc + c_long * c_long)
     return c_long
-
-
-@njit(cache=True, error_model="numpy")
-def homologous_temperature(T, material):
-    """T* = (T - T_ref) / (T_melt - T_ref)."""
-    return (T - material.T_ref) * (1.0 / (material.T_melt - material.T_ref))
-
-
-@njit(cache=True, error_model="numpy")
-def johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material):
-    """(s, d eps_p, thermal factor, a lower bound of it FLOOR_MARGIN_K hotter): the trial deviator
-    returned onto the Johnson-Cook yield surface at the cell's temperature (K) and current strain
-    rate (1/us) if outside it, and the thermal factors of the cell's floors."""
-    homologous = homologous_temperature(T_cell, material)
-    thermal = thermal_factor(strength.m, homologous)
-    s_new, d_eps = radial_return(s_trial, flow_stress(hard, thermal, strength.C, strain_rate, strength.rate_ref),
-                                 strength.G)
-    margin = FLOOR_MARGIN_K * (1.0 / (material.T_melt - material.T_ref))
-    return s_new, d_eps, thermal, thermal_factor_below(strength.m, homologous, thermal, margin)
-
-
-@njit(cache=True, error_model="numpy")
-def floor_at(T_cell, flow_floor, floor_hotter, floor_T):
-    """A cell's flow-stress floor (Mbar) at temperature T_cell (K), from its cached floors: the one set at
-    floor_T (K) while the cell is no hotter, the hotter one up to FLOOR_MARGIN_K above it, else -1 (none)."""
-    if T_cell <= floor_T:
-        return flow_floor
-    if T_cell <= floor_T + FLOOR_MARGIN_K:
-        return floor_hotter
-    return -1.0
-
-
-@njit(cache=True, error_model="numpy")
-def new_floors(hard, thermal, thermal_hotter):
-    """(flow_floor, floor_hotter) after a full evaluation of the flow stress: A + B eps_p^n (Mbar) times
-    the thermal factor at the cell's temperature and its bound FLOOR_MARGIN_K hotter, each just below by
-    FLOOR_SLACK."""
-    return FLOOR_SLACK * hard * thermal, FLOOR_SLACK * hard * thermal_hotter
-
-
-@njit(cache=True, error_model="numpy")
-def inside_floor(equivalent_stress, flow_floor, strain_rate, strength):
-    """Whether a trial von Mises stress is provably elastic: inside the rate-free floor, or (one log)
-    inside the floor times the Johnson-Cook rate factor. A negative floor means none holds."""
-    if equivalent_stress <= flow_floor:
-        return True
-    if flow_floor <= 0.0 or strength.C == 0.0:     # no floor, or no rate term to raise it
-        return False
-    return equivalent_stress <= flow_floor * rate_factor(strength.C, equivalent_strain_rate(strain_rate),
-                                                         strength.rate_ref)
-
-
-def johnson_cook_floored_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter,
-                                floor_T, strength, material):
-    """Johnson-Cook (`Strength`): elastic without evaluating the flow stress while the trial lies inside
-    the cell's floor, else the return at the cell's temperature (K) and current strain rate (1/us), with
-    the cell's new plastic strain, hardening and floors."""
-    floor = floor_at(T_cell, flow_floor, floor_hotter, floor_T)
-    if inside_floor(1.5 * abs(s_trial), floor, strain_rate, strength):
-        return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    s_new, d_eps, thermal, thermal_hotter = johnson_cook_return(s_trial, T_cell, strain_rate, hard, strength, material)
-    if d_eps > 0.0:
-        eps_p += d_eps
-        hard = hardening(strength.A, strength.B, strength.n, eps_p)
-    flow_floor, floor_hotter = new_floors(hard, thermal, thermal_hotter)
-    return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, T_cell
-
-
-def law_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
-               material):
-    """Any law (`LawStrength`): the trial returned onto the law's flow stress at the cell's plastic strain,
-    equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, evaluated every
-    step (no floor; `hard` and the floors pass through), with the cell's shear modulus G (Mbar). A cell
-    with G = 0 (molten) carries no deviator and gains no plastic strain."""
-    if G <= 0.0:
-        return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    Y = law_flow_stress(strength.law, eps_p, equivalent_strain_rate(strain_rate), T_cell, P, eta)
-    s_new, d_eps = radial_return(s_trial, Y, G)
-    return s_new, d_eps, eps_p + d_eps, hard, flow_floor, floor_hotter, floor_T
-
-
-def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
-                   material):
-    """A cell's return after its elastic trial deviator s_trial (Mbar), on scalars: (s, d eps_p, and the
-    cell's new eps_p, hard, flow_floor, floor_hotter, floor_T). `johnson_cook_floored_return` for
-    `Strength`, `law_return` for `LawStrength`, chosen when numba compiles by the type of `strength`
-    and inlined. Scalars in and out: inlined code that indexes the cell arrays cost the 104S run 23%
-    more CPU (reference counts per cell)."""
-
-
-def cell_shear_modulus(strength, P, T, eta):
-    """The shear modulus (Mbar) of a cell at pressure P (Mbar), temperature T (K) and density ratio eta:
-    the run's constant G, or the law's G(P, T, eta) for laws that have one (Steinberg-Guinan, PTW)."""
-
-
-def initial_hardening(strength):
-    """Johnson-Cook's A + B 0^n (Mbar), the cells' initial `hard`; 0 for `LawStrength` (unused)."""
-
-
-def _is_johnson_cook(strength):
-    return getattr(strength, "instance_class", None) is Strength
-
-
-@overload(plastic_return, inline="always")
-def _plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
-                    material):
-    return johnson_cook_floored_return if _is_johnson_cook(strength) else law_return
-
-
-@overload(cell_shear_modulus, inline="always")
-def _cell_shear_modulus(strength, P, T, eta):
-    if _is_johnson_cook(strength):
-        return lambda strength, P, T, eta: strength.G
-    return lambda strength, P, T, eta: law_shear_modulus(strength.law, strength.G, P, T, eta)
-
-
-@overload(initial_hardening, inline="always")
-def _initial_hardening(strength):
-    if _is_johnson_cook(strength):
-        return lambda strength: hardening(strength.A, strength.B, strength.n, 0.0)
-    return lambda strength: 0.0
 
 
 @njit(cache=True, error_model="numpy")

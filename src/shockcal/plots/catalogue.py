@@ -73,7 +73,7 @@ class FigureInputs:
             return None
         import pandas as pd
 
-        from shockcal.records import read_record
+        from shockcal.velocimetry.records import read_record
 
         spec = config["observed"]["records"].get(shot, {})
         t, v = read_record(paths[0], spec.get("time_column"), spec.get("velocity_column"))

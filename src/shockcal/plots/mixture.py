@@ -1,7 +1,7 @@
 """Figures of the feature extractor on one trace: 4 (the features), 5 (early/late mixture split),
 15 (the probability-integral-transform construction).
 
-The numbers come from the project's extractor (`shockcal.features.extract`, whose `Extraction`
+The numbers come from the project's extractor (`shockcal.velocimetry.features.extract`, whose `Extraction`
 keeps the window, the standardized trace, the PIT samples, the mixture and its early/late split). The trace is the first shot's
 measured record when one is configured, else its first usable simulated training run.
 """
@@ -37,7 +37,7 @@ class TraceExtraction:
 
     t: np.ndarray
     v: np.ndarray
-    ex: object  # shockcal.features.Extraction
+    ex: object  # shockcal.velocimetry.features.Extraction
 
     @property
     def features(self) -> pd.Series:
@@ -46,7 +46,7 @@ class TraceExtraction:
 
 def extract_view(trace: pd.DataFrame, settings) -> TraceExtraction:
     """Run the project's extractor on `trace` with the shot's `ExtractorSettings`."""
-    from shockcal.features import extract
+    from shockcal.velocimetry.features import extract
 
     t, v = trace["t_us"].to_numpy(float), trace["v_m_s"].to_numpy(float)
     ex = extract(t, v, settings)

@@ -1,4 +1,4 @@
-"""The strength laws compared (issue 37): log evidence per law, and one page per law of its posterior
+"""The strength laws compared: log evidence per law, and one page per law of its posterior
 predictive runs against the records, past the analysis window."""
 
 from __future__ import annotations
@@ -9,13 +9,13 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from shockcal.features import detect_arrival
 from shockcal.plots.style import COLORS, VELOCITY_LABEL, figure_legend, no_data, styled, subplots
+from shockcal.velocimetry.features import detect_arrival
 
 
 @styled
 def evidence_figure(table: pd.DataFrame):
-    """log Z per law (rows of the evidence table, `shockcal.model_comparison.COLUMNS`) with +-2 sd bars, the
+    """log Z per law (rows of the evidence table, `shockcal.campaign.model_comparison.COLUMNS`) with +-2 sd bars, the
     box-halved value (with +-2 sd) and the box-doubled lower bound marked beside it."""
     fig, axes = subplots(1, 1, width=6.0, height=0.9 + 0.55 * len(table))
     ax = axes[0, 0]

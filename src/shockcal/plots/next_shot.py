@@ -1,6 +1,6 @@
 """Which shot next (`shockcal suggest-shot`): the candidates' expected information gain and why.
 
-Input: the ranking table (results/next_shot/ranking.csv; `shockcal.candidates.ranking_table`). Left:
+Input: the ranking table (results/next_shot/ranking.csv; `shockcal.campaign.candidates.ranking_table`). Left:
 per candidate (best at the top) the expected information gain about the targets jointly (eig_nats)
 and about each target alone (eig_<p>_nats), with +- 2 bootstrap sd bars. Right: per candidate and
 calibration feature, the spread of the draws' features (their sd over the posterior draws) over the

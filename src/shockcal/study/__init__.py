@@ -5,8 +5,10 @@ Layers, each importing only those above it and the library:
 - `adapters`: the config turned into the library's typed settings (`hydro_inputs`, `extractor_settings`,
   `emulator_spec`, `calibration_settings`, ...), the design and the measured features of the study;
 - `validate`: reading a config file, its schema and the rules across keys, the design file's check;
-- `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands.
+- `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands;
+- `next_shot_check`: the next-shot check's candidates as fourth shots of derived configs;
+- `workflow`, `stage_times`: the Snakefile's helpers and the per-stage cost table from its benchmark files.
 
-The library (hydro, design, features, emulator, calibration, ...) never imports this package: the
+The library (hydro, simulators, design, velocimetry, emulator, inference, campaign) never imports this package: the
 `shockcal` commands call an adapter, and the adapter hands the library typed settings.
 """

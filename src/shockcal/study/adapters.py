@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import TYPE_CHECKING
 
-from shockcal.design import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
+from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
 from shockcal.seeds import stream_seed
@@ -22,11 +22,11 @@ from shockcal.study.strength import DEFAULT_MODEL, strength_model
 if TYPE_CHECKING:
     import pandas as pd
 
-    from shockcal.calibration import CalibrationSettings
-    from shockcal.candidates import Candidate
-    from shockcal.emulator import EmulatorSpec
-    from shockcal.features import ExtractorSettings
-    from shockcal.pcgp import Settings as EmulatorSettings
+    from shockcal.campaign.candidates import Candidate
+    from shockcal.emulator.pcgp import Settings as EmulatorSettings
+    from shockcal.emulator.study_emulator import EmulatorSpec
+    from shockcal.inference.calibration import CalibrationSettings
+    from shockcal.velocimetry.features import ExtractorSettings
 
 
 def input_box(config: dict) -> InputBox:
@@ -76,21 +76,21 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
 
 def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
     """`shots.<shot>.analysis` and `features`."""
-    from shockcal.features import ExtractorSettings
+    from shockcal.velocimetry.features import ExtractorSettings
 
     return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
 
 
 def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
     """A next-shot candidate's analysis window (`candidate_config`) and `features`."""
-    from shockcal.features import ExtractorSettings
+    from shockcal.velocimetry.features import ExtractorSettings
 
     return ExtractorSettings(**candidate_config(config, name)["analysis"], **config["features"])
 
 
 def candidate(config: dict, name: str) -> Candidate:
     """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs."""
-    from shockcal.candidates import Candidate
+    from shockcal.campaign.candidates import Candidate
 
     spec = candidate_config(config, name)
     temperature = spec["initial_temperature_K"]
@@ -104,7 +104,7 @@ def candidate_box(config: dict, name: str) -> InputBox:
     reference shot's box plus the range of its thermal increment, `shear_modulus_increment_box_Mbar`:
     it holds both the ranking's draws, G_ref (1 + s dT), and the next-shot check's training runs, whose
     increment is an input of its own)."""
-    from shockcal.candidates import SHEAR_MODULUS, VELOCITY
+    from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY
     from shockcal.hydro import JOHNSON_COOK_INPUTS
     from shockcal.study.config import shear_modulus_box_Mbar, shear_modulus_increment_box_Mbar
     from shockcal.units import CM_US_TO_M_S
@@ -124,7 +124,7 @@ def candidate_box(config: dict, name: str) -> InputBox:
 
 def emulator_settings(config: dict) -> EmulatorSettings:
     """`emulator` (the GP settings by name), seeded by study.seed."""
-    from shockcal.pcgp import Settings as EmulatorSettings
+    from shockcal.emulator.pcgp import Settings as EmulatorSettings
 
     section = config["emulator"]
     names = {f.name for f in fields(EmulatorSettings)} - {"seed"}
@@ -134,7 +134,7 @@ def emulator_settings(config: dict) -> EmulatorSettings:
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
     """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
     inputs eps^n and T*^m for Johnson-Cook only)."""
-    from shockcal.emulator import POWER_INPUTS, EmulatorSpec
+    from shockcal.emulator.study_emulator import POWER_INPUTS, EmulatorSpec
 
     section = config["emulator"]
     jc = strength_model(config) == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
@@ -149,8 +149,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     prior box `inputs` and their units, the shots' impact-velocity boxes for the plateau check
     (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), seeded by the shots'
     "calibration" stream of study.seed (a trial reseeds from its own)."""
-    from shockcal.calibration import CalibrationSettings
-    from shockcal.sampler import SamplerSettings
+    from shockcal.inference.calibration import CalibrationSettings
+    from shockcal.inference.sampler import SamplerSettings
 
     section = config["calibration"]["check"] if check else config["calibration"]
     draws = section["n_eff"] if check else section["draws"]
@@ -236,8 +236,8 @@ def observed_table(config: dict) -> pd.DataFrame:
     import pandas as pd
 
     from shockcal.errors import ConfigError
-    from shockcal.features import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS, record_features
     from shockcal.plausibility import check_plateau
+    from shockcal.velocimetry.features import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS, record_features
 
     observed = config["observed"]
     if observed["source"] == "synthetic":

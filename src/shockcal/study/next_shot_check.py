@@ -99,10 +99,10 @@ def plan_check(config: dict, ranking_path: str | Path, design_file: str | Path, 
 
     import yaml
 
-    from shockcal.candidates import SHEAR_MODULUS, VELOCITY
-    from shockcal.design import write_design
+    from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY
+    from shockcal.design.tables import write_design
     from shockcal.study.adapters import candidate_box, input_box, shot_mapping, study_design
-    from shockcal.workflow import write_if_changed
+    from shockcal.study.workflow import write_if_changed
 
     try:
         names = check_candidates(config, ranking_path)

@@ -225,7 +225,7 @@ def check_next_shot(config: dict, source: str = "config") -> None:
     """The next-shot section: targets among the inputs, each candidate's reference shot known, its name
     not a shot's, its initial temperature below melting, its window clear of the release (plates too
     thin for it) and long enough for the plastic wave to arrive and rise (`PLASTIC_RISE_US`). The split
-    of the elastic and plastic waves needs the posterior (`shockcal.candidates.check_split`)."""
+    of the elastic and plastic waves needs the posterior (`shockcal.campaign.candidates.check_split`)."""
     section, inputs = config["next_shot"], config["inputs"]
     targets = next_shot_targets(config)
     for target in targets:
@@ -238,7 +238,7 @@ def check_next_shot(config: dict, source: str = "config") -> None:
         raise ConfigError(f"{source}: next_shot.shear_modulus_log_slope_per_K: min ({slope['min']:g}) is above max "
                           f"({slope['max']:g})")
     if section["readout_sd_m_s"]:
-        from shockcal.features import CALIBRATION_FEATURES
+        from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
         for feature in section["readout_sd_m_s"]:
             if feature not in CALIBRATION_FEATURES:

@@ -1,4 +1,4 @@
-"""Strength laws as small numba kernels behind one interface (issue 37, first part).
+"""Strength laws as small numba kernels behind one interface.
 
 Each law has a named tuple of parameters in code units (Mbar, K, 1/us, g/cc) and a kernel
 

@@ -2,14 +2,14 @@
 
 `PCGPEmulator` takes inputs X (N, d) in a box and outputs Y (N, F): outputs are standardized per
 column, projected on an orthogonal basis from the SVD of the standardized training outputs, and each
-basis weight gets its own GP (`shockcal.gp`) over inputs scaled to [0, 1]. Prediction returns the mean
+basis weight gets its own GP (`shockcal.emulator.gp`) over inputs scaled to [0, 1]. Prediction returns the mean
 and covariance of the outputs, adding the covariance of what the truncated basis leaves out, with each
 output's sd scaled by a factor calibrated by K-fold (constant per output, or varying smoothly over the
-box: `shockcal.variance_model`), and an error model (`shockcal.error_model`) around them.
+box: `shockcal.emulator.variance_model`), and an error model (`shockcal.emulator.error_model`) around them.
 Cross-validation: closed-form LOO (diagnostic), K-fold and the outer check (everything refitted).
 Saved as one .npz (arrays and a JSON header); no live object is pickled.
 
-This module knows nothing of shots or designs: the study's emulator (`shockcal.emulator`) maps design
+This module knows nothing of shots or designs: the study's emulator (`shockcal.emulator.study_emulator`) maps design
 columns to its inputs.
 """
 
@@ -27,11 +27,11 @@ from joblib import Parallel, delayed
 from scipy.special import expit
 from threadpoolctl import ThreadpoolController, threadpool_limits
 
-from shockcal.error_model import ErrorModel
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.emulator.gp import GaussianProcess, Hyper
+from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
-from shockcal.gp import GaussianProcess, Hyper
 from shockcal.io import atomic_path
-from shockcal.variance_model import VarianceModel
 
 FORMAT_VERSION = 5                  # 5: the smooth sd model (4 had constant sd factors only, 3 no error tails)
 SD_MODELS = ("constant", "smooth")
@@ -39,7 +39,7 @@ Z90 = 1.6449                        # half-width of a central 90% normal band, i
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
 SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
 PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
-log = logging.getLogger("shockcal.emulator")
+log = logging.getLogger("shockcal.emulator.study_emulator")
 
 
 @dataclass
@@ -189,12 +189,12 @@ class PCGPEmulator:
         a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
         traces), when there are at least SWITCH_MIN_RUNS of them. With `settings.sd_model ==
         "smooth"`, the K-fold's log z^2 is first fitted by a smooth variance model g over the box
-        (`shockcal.variance_model`), the sd is multiplied by exp(g(x) / 2), and the constant factors
+        (`shockcal.emulator.variance_model`), the sd is multiplied by exp(g(x) / 2), and the constant factors
         are then fitted to the z values so rescaled: g gives the shape over the box, the factors the
         level (and the switched regime's level).
 
         With `settings.error_tails == "student_t"`, the error model's (dof, scale) are fitted to
-        the Mahalanobis distances of the same K-fold's errors (`shockcal.error_model`).
+        the Mahalanobis distances of the same K-fold's errors (`shockcal.emulator.error_model`).
         """
         settings = settings or Settings()
         model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]

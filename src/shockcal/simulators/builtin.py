@@ -15,12 +15,12 @@ import logging
 import numpy as np
 import pandas as pd
 
-from shockcal.design import ShotMapping
+from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, run_shot
 from shockcal.progress import progress
 
-log = logging.getLogger("shockcal.simulate")
+log = logging.getLogger("shockcal.simulators.builtin")
 DIAGNOSTICS = ["max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
                "n_steps", "wall_time_s"]
 UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_rate_per_us": "1/us",

@@ -1,4 +1,4 @@
-"""Which shot next (issue 38): the expected information gain of a candidate shot, from the features of
+"""Which shot next: the expected information gain of a candidate shot, from the features of
 the current posterior's draws at the candidate's conditions (docs/next_shot.md).
 
 The current joint posterior is the next shot's prior. Its draws theta_i (i = 1..N, equal weights)
@@ -101,7 +101,7 @@ class InformationGain:
 
 def noise_sd(features, sd_fraction: float = 0.01, readout_sd=0.0, lambda_y=None) -> np.ndarray:
     """The measurement noise sd of each draw's features: the observation error sd_fraction |g| / sqrt(lambda_y)
-    (`shockcal.problem`'s, with the draw's feature in place of the measured one) and the extractor's
+    (`shockcal.inference.problem`'s, with the draw's feature in place of the measured one) and the extractor's
     read-out sd, in quadrature.
 
     Args:

@@ -8,7 +8,7 @@ the README keeps the table).
 
 `simulate_overhead` reads each simulate job's start-up and write-out: its benchmark wall seconds minus
 the hydrocode seconds of its runs (`wall_time_s` in the chunk it wrote), in seconds and as a share of
-the job (issue 16's goal: under 2%).
+the job (the per-job overhead goal: under 2%).
 """
 
 from __future__ import annotations

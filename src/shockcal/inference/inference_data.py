@@ -39,8 +39,8 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
-from shockcal.features import CALIBRATION_FEATURES
 from shockcal.io import atomic_path
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 WEIGHTED_GROUP = "weighted_posterior"
 

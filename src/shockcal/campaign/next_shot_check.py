@@ -1,4 +1,4 @@
-"""The realized check of the next-shot ranking (issue 38; docs/next_shot.md): truths drawn from the joint
+"""The realized check of the next-shot ranking (docs/next_shot.md): truths drawn from the joint
 posterior, and what their calibrations with and without a candidate shot realized against what the
 ranking predicted.
 
@@ -24,10 +24,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from shockcal.candidates import SHEAR_MODULUS, VELOCITY, Candidate, candidate_design
+from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY, Candidate, candidate_design
+from shockcal.campaign.next_shot import normal_scores
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
-from shockcal.next_shot import normal_scores
 
 
 def truth_design(posterior: pd.DataFrame, names: Sequence[str], candidates: Mapping[str, tuple[Candidate, str, str | None]],

@@ -28,11 +28,11 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
+from shockcal.inference.summaries import summarize
 from shockcal.progress import Every
 from shockcal.seeds import stream_seed
-from shockcal.summaries import summarize
 
-log = logging.getLogger("shockcal.sampler")
+log = logging.getLogger("shockcal.inference.sampler")
 
 
 @dataclass
@@ -83,7 +83,7 @@ def nested_sample(prior_transform, log_likelihood, ndim: int, n_live: int, n_eff
     low-m arm") gets as many live points as its mass needs instead of being cut off by the bounds.
     The draws' `log_likelihood` is the caller's, without the ratio.
 
-    Progress goes to the log (logger `shockcal.sampler`, INFO) at most every 30 s: evaluations spent,
+    Progress goes to the log (logger `shockcal.inference.sampler`, INFO) at most every 30 s: evaluations spent,
     then the effective sample size against `n_eff`. nautilus's own `verbose` status is not used: it
     redraws one line with carriage returns, padded to the terminal's width, which a job's log file
     keeps as one long line.
@@ -276,7 +276,7 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
     """Sample a problem's posterior with nautilus.
 
     Args:
-        problem: a `shockcal.problem.Problem` (prior transform, batch log-likelihood, names).
+        problem: a `shockcal.inference.problem.Problem` (prior transform, batch log-likelihood, names).
         settings: the sampler's settings.
         other_powers: `Problem.cube_power`'s `others` ("error": a power of an input the problem does
             not calibrate is an error; "ignore": skipped).

@@ -1,4 +1,4 @@
-"""How a uniform prior's box moves the evidence, from one nested-sampling run's weighted draws (issue 37).
+"""How a uniform prior's box moves the evidence, from one nested-sampling run's weighted draws.
 
 With k box parameters whose uniform prior box is [lower, upper] (the other calibrated inputs keep their
 priors), each box halved or doubled about its centre:
@@ -24,9 +24,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from shockcal.sampler import WeightedDraws
+from shockcal.inference.sampler import WeightedDraws
 
-log = logging.getLogger("shockcal.box_sensitivity")
+log = logging.getLogger("shockcal.campaign.box_sensitivity")
 
 FACE_BAND = 0.05          # "near a face": within this share of the box width
 

@@ -1,7 +1,7 @@
 """The study's emulator of the calibration features: design columns mapped onto PC-GP emulators.
 
-`fit_emulator(design, features, spec)` joins each shot's features (`shockcal.features`) to the design
-on `run` and fits one array-level `PCGPEmulator` (`shockcal.pcgp`) per block, in one of two
+`fit_emulator(design, features, spec)` joins each shot's features (`shockcal.velocimetry.features`) to the design
+on `run` and fits one array-level `PCGPEmulator` (`shockcal.emulator.pcgp`) per block, in one of two
 structures (`EmulatorSpec.structure`, config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
@@ -24,18 +24,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.design import ShotMapping
-from shockcal.error_model import ErrorModel
+from shockcal.design.tables import ShotMapping
+from shockcal.emulator.error_model import ErrorModel
+from shockcal.emulator.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
 from shockcal.errors import InputError
-from shockcal.features import CALIBRATION_FEATURES
 from shockcal.io import atomic_path
-from shockcal.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
 from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
-log = logging.getLogger("shockcal.emulator")
+log = logging.getLogger("shockcal.emulator.study_emulator")
 
 
 @dataclass
@@ -412,7 +412,7 @@ def single_wave_switches(n_shots: int) -> list[Switch]:
 
 
 def feature_groups(n_shots: int) -> list[list[int]]:
-    """Groups of output columns sharing one smooth variance model (`shockcal.variance_model`): each
+    """Groups of output columns sharing one smooth variance model (`shockcal.emulator.variance_model`): each
     calibration feature across the shots (features in CALIBRATION_FEATURES order, shot after shot).
     A feature's error grows in the same corners of the box in every shot (FLAG runs 0-499), and pooling
     the shots thins the noise of log z^2; one model per output fitted worse (docs/emulator.md)."""

@@ -1,9 +1,9 @@
 """When the release from the flyer's back reaches the free surface, on a record and on posterior-predictive
-runs (issue 37: does any law reach 104S's release later than Johnson-Cook's runs?).
+runs (the strength-law comparison: does any law reach 104S's release later than Johnson-Cook's runs?).
 
 A trace's release time is the first sample after its plastic plateau's feature time (`t_plastic`, the
 extractor's) at which the velocity falls below the plateau's velocity (`v_plastic`) minus a margin, in us
-after the trace's own arrival (`shockcal.features.detect_arrival`), so a record and a simulation compare
+after the trace's own arrival (`shockcal.velocimetry.features.detect_arrival`), so a record and a simulation compare
 without aligning their clocks. The margin (20 m/s) is above the records' dips on the plateau (up to about
 11 m/s on 105S and 106S within 0.3 us of t_plastic) and well below the release's fall (hundreds of m/s).
 """
@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from shockcal.features import detect_arrival
+from shockcal.velocimetry.features import detect_arrival
 
 RELEASE_MARGIN_M_S = 20.0
 RELEASE_COLUMNS = ["model", "shot", "release_record_us", "release_predicted_median_us", "release_predicted_q05_us",

@@ -23,7 +23,7 @@ from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
-log = logging.getLogger("shockcal.design")
+log = logging.getLogger("shockcal.design.tables")
 
 
 @dataclass(frozen=True)

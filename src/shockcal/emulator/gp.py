@@ -19,7 +19,7 @@ from functools import cached_property
 import numpy as np
 from scipy import linalg, optimize
 
-from shockcal.correlation import (
+from shockcal.emulator.correlation import (
     correlation_and_slope,
     cross_correlation,
     family_code,
@@ -98,7 +98,7 @@ def neg_log_posterior(phi: np.ndarray, x: np.ndarray, y: np.ndarray, family: str
     """Negative log marginal posterior of the hyperparameters and its analytic gradient.
 
     The correlation matrix, its slope and the gradient's sums over pairs are numba kernels
-    (`shockcal.correlation`). With `fit_mean` the constant mean is profiled out at its GLS estimate
+    (`shockcal.emulator.correlation`). With `fit_mean` the constant mean is profiled out at its GLS estimate
     (no extra gradient term there).
     """
     hyp = Hyper.unpack(phi)

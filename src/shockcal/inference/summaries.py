@@ -13,7 +13,7 @@ def summarize(draws, names: list[str]) -> pd.DataFrame:
     (`quantile_mcse` for one run; `quantile_mcse_between` for pooled runs), and the Kish ESS of the weights.
 
     Args:
-        draws: weighted draws (`shockcal.sampler.WeightedDraws`: points (N, d), normalised weights, and
+        draws: weighted draws (`shockcal.inference.sampler.WeightedDraws`: points (N, d), normalised weights, and
             `replicate`, each draw's run, for pooled runs).
         names: the d parameters' names, in column order.
     """

@@ -11,13 +11,13 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.calibration import CalibrationSettings, calibrate
 from shockcal.errors import InputError, ShockcalError
-from shockcal.features import CALIBRATION_FEATURES
-from shockcal.problem import LAMBDA_Y_PRIOR, Problem, log_density, prior_box
+from shockcal.inference.calibration import CalibrationSettings, calibrate
+from shockcal.inference.problem import LAMBDA_Y_PRIOR, Problem, log_density, prior_box
 from shockcal.progress import progress
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
-log = logging.getLogger("shockcal.calibration")
+log = logging.getLogger("shockcal.inference.calibration")
 
 
 def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None,

@@ -1,12 +1,12 @@
 """Strength laws compared by their evidence: one row per law from its joint posterior and its emulator's
-held-out errors (issue 37). The table's columns:
+held-out errors. The table's columns:
 
     model, n_params, log_z, log_z_sd, log_bf_vs_johnson_cook, log_bf_sd, n_box_params, log_z_box_half,
     log_z_box_half_sd, log_z_box_double, posterior_mass_near_faces, kfold_rmse_m_s, outer_rmse_m_s
 
 log_bf_vs_johnson_cook = log Z - log Z(johnson-cook), its sd the two sds in quadrature (independent
 runs). log_z_sd is nautilus's importance-sampling estimate (`Posterior.log_evidence_sd`), a lower bound
-of the Monte Carlo spread. The box columns (`shockcal.box_sensitivity`): the evidence with the box of the
+of the Monte Carlo spread. The box columns (`shockcal.campaign.box_sensitivity`): the evidence with the box of the
 law's own and shear-modulus parameters halved (exact, with its sd) and doubled (a lower bound) about its
 centre, from the same run's weighted draws, and the posterior mass near the faces the doubled box moves.
 """
@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import pandas as pd
 
-from shockcal.box_sensitivity import BoxSensitivity
+from shockcal.campaign.box_sensitivity import BoxSensitivity
 from shockcal.errors import InputError
 
 REFERENCE_MODEL = "johnson-cook"

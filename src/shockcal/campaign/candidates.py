@@ -1,4 +1,4 @@
-"""Next-shot candidates (issue 38; docs/next_shot.md): the joint posterior's draws as a candidate shot's
+"""Next-shot candidates (docs/next_shot.md): the joint posterior's draws as a candidate shot's
 design, the check that the candidate's waves split, and the candidate's score from its runs' features.
 
 A candidate's design holds one row per posterior draw: the draw's inputs (Table IV units; the same
@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from shockcal.design import ShotMapping
+from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
-from shockcal.predict import draw_posterior_design
+from shockcal.inference.predict import draw_posterior_design
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
 
 VELOCITY = "velocity_cm_us"
@@ -142,7 +142,7 @@ def check_design(design: pd.DataFrame, names: Sequence[str], source: str) -> pd.
 def score_candidate(features: pd.DataFrame, design: pd.DataFrame, feature_names: Sequence[str],
                     parameters: Sequence[str], targets: Sequence[str], sd_fraction: float,
                     readout_sd_m_s: Sequence[float], seed: int) -> dict:
-    """One candidate's expected information gain (`shockcal.next_shot`) from its runs' features.
+    """One candidate's expected information gain (`shockcal.campaign.next_shot`) from its runs' features.
 
     Args:
         features: the features table of the candidate's runs (`run`, `status`, the features; m/s).
@@ -163,7 +163,7 @@ def score_candidate(features: pd.DataFrame, design: pd.DataFrame, feature_names:
     expected posterior sd (prior_sd_<p>, expected_sd_<p>, its input's unit), and per feature the
     spread of the draws' features (feature_sd_<f>) and the median measurement noise (noise_sd_<f>), m/s.
     """
-    from shockcal.next_shot import expected_information_gain, noise_sd
+    from shockcal.campaign.next_shot import expected_information_gain, noise_sd
 
     table = design.merge(features[["run", "status", *feature_names]], on="run", how="left", validate="one_to_one")
     ok = (table["status"] == "ok").to_numpy() & np.isfinite(table[list(feature_names)].to_numpy(float)).all(axis=1)

@@ -1,8 +1,8 @@
 """Calibration of a study's shots: the measured features against the study's emulator, nested sampling,
 the posterior with its summary (SPEC sections 5-6).
 
-The density is `shockcal.problem.Problem`, the sampler `shockcal.sampler`, the summaries
-`shockcal.summaries`, the synthetic-truth checks `shockcal.coverage`.
+The density is `shockcal.inference.problem.Problem`, the sampler `shockcal.inference.sampler`, the summaries
+`shockcal.inference.summaries`, the synthetic-truth checks `shockcal.inference.coverage`.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
+from shockcal.inference.problem import Problem
+from shockcal.inference.sampler import Posterior, SamplerSettings, sample
 from shockcal.plausibility import check_observed_table, check_plateau
-from shockcal.problem import Problem
-from shockcal.sampler import Posterior, SamplerSettings, sample
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,7 @@ class CalibrationSettings:
         check_units: whether to check that the measurements look like m/s and us (`shockcal.plausibility`).
         units: each parameter's unit, for the summary.
         bounds: the prior box by input (native units), or None for the emulator's box; it must lie
-            inside the emulator's (`shockcal.problem.prior_box`).
+            inside the emulator's (`shockcal.inference.problem.prior_box`).
         velocity_boxes: shot -> its impact-velocity box (m/s), against which each shot's measured
             plastic plateau is checked (`shockcal.plausibility.check_plateau`); shots absent: unchecked.
         check_plateau: whether a plateau outside the band stops the calibration (else a warning).

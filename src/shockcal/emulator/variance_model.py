@@ -15,7 +15,7 @@ K-fold's log z^2 (scikit-learn's `RidgeCV`, penalty chosen by its efficient leav
 regressors; each group's target is the mean over its outputs of log z^2 less each output's mean, so
 the outputs of a group share g and a group pools their noise (log z^2 of one value has an sd of 2.2).
 g is centred on the training rows; the level stays with the emulator's per-output sd factors
-(`shockcal.pcgp`), fitted after g. Cubic B-splines keep g twice differentiable in x, so a calibration
+(`shockcal.emulator.pcgp`), fitted after g. Cubic B-splines keep g twice differentiable in x, so a calibration
 likelihood that uses it stays smooth.
 """
 

@@ -2,7 +2,7 @@
 
 The noise is taken as the residuals of a cubic fit over the record's plastic plateau (from where
 its monotone fit reaches 97% of the rise to the end of the analysis window: the longest stretch
-without a rise; `shockcal.features.NOISE_PLATEAU_LEVEL`), modelled as a
+without a rise; `shockcal.velocimetry.features.NOISE_PLATEAU_LEVEL`), modelled as a
 stationary Gaussian autoregressive process AR(p): Yule-Walker coefficients (scipy's Toeplitz solver)
 for p = 1 ... `MAX_ORDER`, p chosen by AIC (n log sigma_p^2 + 2p, sigma_p^2 the innovation
 variance). The released VISAR records ring: their residuals oscillate with periods of 7-17 ns, which

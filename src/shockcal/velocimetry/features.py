@@ -18,7 +18,7 @@
    of (y, t). The samples move smoothly with the trace, so neighbouring runs get neighbouring samples.
    Their distribution is known exactly: uniform between consecutive (t, y) pairs where y rises.
 4. A k = 5 Gaussian mixture is fitted by EM to that exact distribution, the limit of infinitely many
-   samples (`fit_mixture_exact`, `shockcal.mixture_fit`: Gauss-Legendre quadrature over its uniform
+   samples (`fit_mixture_exact`, `shockcal.velocimetry.mixture_fit`: Gauss-Legendre quadrature over its uniform
    pieces), from `MIXTURE_STARTS` fixed starts made from the samples as scikit-learn made them (means
    at the samples' k quantiles, then k-means starts seeded 0, 1, ...), each run to convergence
    (`MIXTURE_TOL`, far below scikit-learn's default 1e-3, which stops on a plateau of the
@@ -36,7 +36,7 @@
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time (a noisy trace: the value of a
-   least-squares line over the record's read-out window, `shockcal.record_noise`).
+   least-squares line over the record's read-out window, `shockcal.velocimetry.record_noise`).
 6. A noisy trace's read-out error: the spread of its features over replicates of its noise
    (`readout_replicates`, `readout_sd`), which the calibration adds to the 1% observation sd.
 """
@@ -57,7 +57,7 @@ from shockcal.errors import InputError, ShockcalError
 if TYPE_CHECKING:
     import pandas as pd
 
-log = logging.getLogger("shockcal.features")
+log = logging.getLogger("shockcal.velocimetry.features")
 FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
 COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
 CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]   # what the emulator and calibration use
@@ -112,7 +112,7 @@ class Extraction:
     samples: np.ndarray      # PIT samples (us)
     mixture: Mixture
     early: np.ndarray        # boolean mask of early components
-    noise: object = None     # the record's NoiseModel (shockcal.record_noise) when read robustly, else None
+    noise: object = None     # the record's NoiseModel (shockcal.velocimetry.record_noise) when read robustly, else None
 
 
 def baseline_and_noise(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
@@ -168,7 +168,7 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
             fits it by scikit-learn's EM to the samples (`fit_mixture`). Both draw the samples: the
             figures show them.
         robust: the noisy-trace read (isotonic monotone fit, velocities from local linear fits over the
-            record's noise window, `shockcal.record_noise`) or the noise-free one (running maximum,
+            record's noise window, `shockcal.velocimetry.record_noise`) or the noise-free one (running maximum,
             velocities interpolated between two samples). None (default): robust when the trace is
             noisy before its arrival (`is_noisy`), so simulated traces are read as before.
 
@@ -222,9 +222,9 @@ def monotone_cdf(v_window: np.ndarray, robust: bool) -> np.ndarray:
 
 
 def record_noise(t, v, plateau_start_us: float, end_us: float):
-    """The trace's noise model from its plateau (`shockcal.record_noise.estimate_noise`); a FeatureError
+    """The trace's noise model from its plateau (`shockcal.velocimetry.record_noise.estimate_noise`); a FeatureError
     when the plateau is too short to estimate it."""
-    from shockcal.record_noise import estimate_noise
+    from shockcal.velocimetry.record_noise import estimate_noise
 
     try:
         return estimate_noise(t, v, plateau_start_us, end_us)
@@ -312,10 +312,10 @@ def fit_mixture(samples: np.ndarray, n_components: int) -> Mixture:
 
 def fit_mixture_exact(t_window: np.ndarray, cdf_window: np.ndarray, samples: np.ndarray, n_components: int) -> Mixture:
     """The EM fit of highest expected log-likelihood under the piecewise-linear CDF the PIT samples are
-    drawn from (`shockcal.mixture_fit`): the limit of `fit_mixture` as the number of samples grows. The
+    drawn from (`shockcal.velocimetry.mixture_fit`): the limit of `fit_mixture` as the number of samples grows. The
     same starts (scikit-learn's, made from the samples), the same EM steps and stopping rule
     (`MIXTURE_TOL`), the same variance floor, on the standardized scale."""
-    from shockcal.mixture_fit import fit_piecewise_linear_cdf
+    from shockcal.velocimetry.mixture_fit import fit_piecewise_linear_cdf
 
     (weights, means, sds), _ = fit_piecewise_linear_cdf(t_window, cdf_window, n_components, MIXTURE_STARTS,
                                                         MIXTURE_TOL, MIXTURE_MAX_ITER, starts=samples)
@@ -327,7 +327,7 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     """The features of `replicates` copies of a noisy trace's signal, each with an independent replicate
     of its noise added: a parametric bootstrap. The signal is the trace smoothed by the read-out's own
     local line (scipy's Savitzky-Golay filter of order 1 over the read-out window), the noise the AR
-    model fitted to the trace's plateau residuals (`shockcal.record_noise`). Their spread is the
+    model fitted to the trace's plateau residuals (`shockcal.velocimetry.record_noise`). Their spread is the
     extractor's read-out error on the trace.
 
     Args:
@@ -423,7 +423,7 @@ def readout_sd(values) -> float:
 
 def record_features(path, settings: ExtractorSettings, shot: str, time_column=None, velocity_column=None,
                     replicates: int = 0, seed: int = 0) -> dict:
-    """The ten features of a measured record (`shockcal.records.read_record`) of `shot`; an InputError
+    """The ten features of a measured record (`shockcal.velocimetry.records.read_record`) of `shot`; an InputError
     naming the record and the shot when it has none.
 
     With `replicates` > 0, also each calibration feature's read-out sd on the record
@@ -431,7 +431,7 @@ def record_features(path, settings: ExtractorSettings, shot: str, time_column=No
     `seed`; `readout_replicates`) and the noise model it came from (`noise_sd_m_s`, `noise_ar_order`,
     `readout_half_window_ns`); with 0, only the read-out window and the noise sd, and read-out sds of 0.
     """
-    from shockcal.records import read_record
+    from shockcal.velocimetry.records import read_record
 
     t, v = read_record(path, _column(time_column), _column(velocity_column))
     try:

@@ -5,7 +5,7 @@ For the shots calibrated together, the measured features y (m/s, four per shot) 
     y = eta(theta) + e + eps,   e ~ t_nu(0, s C_eta(theta)),   eps ~ N(0, Sigma_y / lambda_y),
 
 eta and C_eta the emulator's predictive mean and covariance, (nu, s) its error model (a Student t
-fitted to its K-fold errors, `shockcal.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
+fitted to its K-fold errors, `shockcal.emulator.error_model`; nu = inf, s = 1 is the paper's Gaussian), one
 e per emulator block (their errors are independent), Sigma_y diagonal with variance
 (`observed.sd_fraction` y)^2 + r^2 for each measured feature y (1%, and r the extractor's read-out sd on
 the record, `readout_sd_<feature>` in the observed table), lambda_y ~ Gamma(5, 5), theta uniform on the
@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from shockcal.error_model import ErrorModel
+from shockcal.emulator.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.plausibility import outside_box
 

@@ -4,7 +4,7 @@
 which names the columns, e.g. "% Up (m/s)  t (us)" or "% time (us)  Up (m/s)": the order differs
 between files) and general CSV or whitespace tables whose time and velocity columns the user names.
 The record is returned as released: noise, baseline offset and pre-trigger content are handled by
-the feature extractor (shockcal.features), not here. A record whose peak velocity, duration or time
+the feature extractor (shockcal.velocimetry.features), not here. A record whose peak velocity, duration or time
 step is implausible for a plate-impact VISAR record in m/s and microseconds (shockcal.plausibility:
 km/s, ns, ...) is an error unless the environment sets SHOCKCAL_ALLOW_IMPLAUSIBLE_RECORDS=1.
 """
@@ -22,7 +22,7 @@ import pandas as pd
 from shockcal.errors import InputError
 from shockcal.plausibility import PEAK_VELOCITY_M_S, RECORD_DURATION_US, TIME_STEP_US, range_problem
 
-log = logging.getLogger("shockcal.records")
+log = logging.getLogger("shockcal.velocimetry.records")
 MIN_POINTS = 50
 OPT_OUT = "SHOCKCAL_ALLOW_IMPLAUSIBLE_RECORDS"
 _TIME_NAMES = re.compile(r"^(t|time|t_us)\b", re.IGNORECASE)

@@ -31,7 +31,7 @@ import pandas as pd
 from shockcal.errors import InputError
 
 COLUMNS = ["input", "S1", "S1_conf", "ST", "ST_conf"]
-log = logging.getLogger("shockcal.sensitivity")
+log = logging.getLogger("shockcal.campaign.sensitivity")
 
 
 def sobol_indices(function: Callable[[np.ndarray], np.ndarray], names: list[str], lower, upper, n_base: int,
@@ -107,7 +107,7 @@ def emulator_sobol(emulator, shots: list[str], bounds: Mapping[str, tuple[float,
     the inputs the shot reads, on the box `bounds`.
 
     Args:
-        emulator: the study's `shockcal.emulator.Emulator`.
+        emulator: the study's `shockcal.emulator.study_emulator.Emulator`.
         shots: the shots, each analysed on its own inputs.
         bounds: design input -> (lower, upper), native units; every input the shots read.
         n_base: Saltelli's base sample (power of 2); each shot costs n_base (d + 2) emulator predictions.

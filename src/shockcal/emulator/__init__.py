@@ -1,0 +1,18 @@
+"""Emulator: the principal-component Gaussian-process emulator of the features.
+
+`gp` (one GP at its MAP hyperparameters) on the correlation kernels of `correlation`; `pcgp` (the
+array-level `PCGPEmulator` and its `Settings`: fit, predict, K-fold, save, load) with its error model
+(`error_model`: Student t or Gaussian) and the error's variance over the box (`variance_model`);
+`study_emulator` maps a study's design columns and shots onto PC-GP blocks (`fit_emulator`,
+`Emulator`). Hands on a fitted emulator (`emulator.npz` + `emulator.json`) to the inference.
+"""
+
+from shockcal._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "PCGPEmulator": "shockcal.emulator.pcgp",
+    "Settings": "shockcal.emulator.pcgp",
+    "Emulator": "shockcal.emulator.study_emulator",
+    "EmulatorSpec": "shockcal.emulator.study_emulator",
+    "fit_emulator": "shockcal.emulator.study_emulator",
+})

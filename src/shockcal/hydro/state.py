@@ -1,0 +1,115 @@
+"""The hydrocode's state and parameters as named tuples in code units (cm, us, g/cc, Mbar), the kernels' currency.
+
+`Material`, `InitialState`, `Strength` (Johnson-Cook) or `LawStrength` (any law) and `Numerics` are what a run
+hands the kernels (`shockcal.hydro.settings` builds them from user units); `Nodes` and `Cells` are the mesh's
+state (drawn in `shockcal.hydro.solver`); `KernelResult` is what `solver.simulate` returns, with a status code
+and its reason (`FAILURE_REASONS`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+STATUS_OK, STATUS_NEGATIVE_VOLUME, STATUS_NAN, STATUS_DT_COLLAPSE = 0, 1, 2, 3
+FAILURE_REASONS = {STATUS_NEGATIVE_VOLUME: "negative cell volume", STATUS_NAN: "NaN in cell state",
+                   STATUS_DT_COLLAPSE: "time step collapsed"}
+
+
+class Material(NamedTuple):
+    """Flyer and target material: Mie-Grueneisen EOS and thermal constants (code units)."""
+
+    rho0: float            # g/cc
+    c1: float              # Mbar
+    c2: float              # Mbar
+    c3: float              # Mbar
+    gamma0: float
+    T_ref: float           # K
+    T_melt: float          # K
+    cv: float              # (cm/us)^2 / K
+
+
+class InitialState(NamedTuple):
+    """Both plates before impact: at rest, at zero pressure, at the shot's initial temperature (code
+    units). At T_ref: rho = rho0, E = 0; hotter, E = cv (T0 - T_ref) and rho solves P(rho, E) = 0
+    (`MaterialProperties.initial_state`)."""
+
+    rho: float             # g/cc
+    E: float               # specific internal energy, (cm/us)^2
+
+
+class Strength(NamedTuple):
+    """Shear modulus and Johnson-Cook parameters of one run (Mbar, -, 1/us)."""
+
+    G: float
+    A: float
+    B: float
+    C: float
+    n: float
+    m: float
+    rate_ref: float
+
+
+class LawStrength(NamedTuple):
+    """Any strength law of `shockcal.hydro.laws` in one run: its named tuple in code units and the
+    shot's shear modulus G (Mbar), used only by laws without a shear-modulus law of their own
+    (Johnson-Cook, Zerilli-Armstrong). numba compiles the kernels once per law tuple type."""
+
+    law: tuple
+    G: float
+
+
+class Numerics(NamedTuple):
+    """Artificial viscosity and time stepping (us)."""
+
+    q1: float
+    q2: float
+    cfl: float
+    dt_initial: float
+    dt_max: float
+
+
+class KernelResult(NamedTuple):
+    """What `simulate` returns (code units: cm/us, Mbar cm, us, K)."""
+
+    v_free_surface: np.ndarray   # target's free-surface velocity at t_out, cm/us
+    energy: np.ndarray           # total energy per unit area at t_out (zero past a failure), Mbar cm
+    status: int                  # STATUS_OK or a failure code (FAILURE_REASONS)
+    fail_cell: int               # the failed cell, or -1
+    fail_time: float             # us
+    n_steps: int
+    max_plastic_rate: float      # 1/us, over the target's cells
+    max_temperature: float       # K
+    max_plastic_strain: float
+
+
+class Nodes(NamedTuple):
+    """Node velocity (cm/us) and lumped mass per unit area (g/cm^2), nodes 0..N+1."""
+
+    u: np.ndarray
+    mass: np.ndarray
+
+
+class Cells(NamedTuple):
+    """Cell state, cells 0..N (cell `gap` is the contact gap: no mass, its length is the gap).
+
+    `flow_floor` is a lower bound of the cell's rate-free flow stress (A + B eps_p^n)(1 - T*^m),
+    valid while its temperature stays at or below `floor_T`, the temperature of its last full
+    evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
+    is one valid up to `plastic_return.FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
+    so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
+    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. `hard` and
+    the floors are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused."""
+
+    mass: np.ndarray       # g/cm^2
+    length: np.ndarray     # cm
+    E: np.ndarray          # specific internal energy, (cm/us)^2
+    P: np.ndarray          # pressure, Mbar
+    s: np.ndarray          # deviator s_xx, Mbar
+    sigma: np.ndarray      # total stress -(P + q) + s, Mbar
+    eps_p: np.ndarray      # equivalent plastic strain
+    hard: np.ndarray       # A + B eps_p^n, Mbar
+    flow_floor: np.ndarray  # Mbar
+    floor_hotter: np.ndarray  # Mbar
+    floor_T: np.ndarray    # K

@@ -1,0 +1,20 @@
+"""Inference: posteriors of the strength and shot inputs given the measured features.
+
+`problem` (the posterior density `Problem`: prior transform and batch log-likelihood through the
+emulator), `sampler` (nested sampling with nautilus into a `Posterior`, with log Z and its sd),
+`summaries` (weighted quantiles and their Monte Carlo errors), `calibration` (a study's shots
+against its emulator), `coverage` (synthetic-truth checks), `inference_data` (a `Posterior` as
+ArviZ InferenceData) and `predict` (posterior draws as a design, emulator predictions at a design).
+Hands on posteriors (draws, weighted draws, summaries, netCDF) to predictions, figures and the campaign.
+"""
+
+from shockcal._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "Problem": "shockcal.inference.problem",
+    "SamplerSettings": "shockcal.inference.sampler",
+    "Posterior": "shockcal.inference.sampler",
+    "sample": "shockcal.inference.sampler",
+    "CalibrationSettings": "shockcal.inference.calibration",
+    "calibrate": "shockcal.inference.calibration",
+})
