@@ -31,7 +31,7 @@ from shockcal.errors import InputError
 from shockcal.io import atomic_path
 from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.features import CALIBRATION_FEATURES, reason_kind
 
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
@@ -341,7 +341,10 @@ def training_data(design: pd.DataFrame, features: pd.DataFrame, shot: str, sourc
         usable &= features["status"].eq("ok")
     dropped = int((~usable).sum())
     if dropped:
-        log.info("shot %s: %d of %d runs dropped (failed or NaN features)", shot, dropped, len(features))
+        reasons = (features.loc[~usable, "reason"].astype(str).map(reason_kind).value_counts()
+                   if "reason" in features.columns else {})
+        log.info("shot %s: %d of %d runs dropped (failed or NaN features)%s", shot, dropped, len(features),
+                 "".join(f"; {kind}: {count}" for kind, count in reasons.items()))
     return design.merge(features.loc[usable, ["run", *CALIBRATION_FEATURES]], on="run", how="inner")
 
 

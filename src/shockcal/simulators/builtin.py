@@ -23,6 +23,12 @@ from shockcal.progress import progress
 log = logging.getLogger("shockcal.simulators.builtin")
 DIAGNOSTICS = ["max_strain_rate_per_us", "max_temperature_K", "max_plastic_strain", "energy_error",
                "n_steps", "wall_time_s"]
+def simulation_columns(inputs: list[str]) -> list[str]:
+    """The simulations table's columns, in order, for a shot that reads the design columns `inputs`."""
+    return ["run", "shot", *inputs, "impact_velocity_m_s", "shear_modulus_GPa", "status", "reason", *DIAGNOSTICS,
+            "t_us", "v_m_s"]
+
+
 UNITS = {"impact_velocity_m_s": "m/s", "shear_modulus_GPa": "GPa", "max_strain_rate_per_us": "1/us",
          "max_temperature_K": "K", "max_plastic_strain": "-", "energy_error": "relative", "wall_time_s": "s",
          "t_us": "us", "v_m_s": "m/s"}

@@ -10,6 +10,7 @@ extractor's modules are imported by their adapters, so that a simulate job does 
 from __future__ import annotations
 
 from dataclasses import fields
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
@@ -193,8 +194,9 @@ def extension_inputs(config: dict) -> dict[str, str]:
 
 def study_design(config: dict, n_runs: int | None = None, seed: int | None = None, stream: str = "design",
                  lhs: bool = False) -> tuple[pd.DataFrame, str]:
-    """(design, where it came from): the config's design file (its first `n_runs` rows), or, without
-    one or with `lhs`, a Latin hypercube of `n_runs` (default design.n_runs) over the box of
+    """(design, where it came from): the archive's design rows that have runs (`simulator.kind: archive`),
+    or the config's design file (its first `n_runs` rows), or, without one or with `lhs`, a Latin
+    hypercube of `n_runs` (default design.n_runs) over the box of
     `base_inputs`, seeded from `stream` of study.seed (`shockcal.seeds`) unless `seed` is given.
 
     An input that only a shot outside `design.base_shots` reads (a shot added to a study: its own
@@ -202,9 +204,13 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
     column of its own for the existing rows (`extend_design`, stream design_extension keyed by the
     shot and the input): no existing column changes, so no other shot's runs rerun."""
     from shockcal.io import read_table
+    from shockcal.study.simulator import archive_design, simulator_kind
 
     names, extension = list(config["inputs"]), extension_inputs(config)
-    if not lhs and config["design"]["file"]:
+    if not lhs and simulator_kind(config) == "archive":
+        design, source = archive_design(config, lambda path: load_study_design(path, config))
+        design = design if n_runs is None else design.iloc[:n_runs]
+    elif not lhs and config["design"]["file"]:
         path = config["design"]["file"]
         given = set(read_table(path).columns)
         design = load_study_design(path, config, [n for n in names if n not in extension or n in given])
@@ -261,3 +267,34 @@ def observed_table(config: dict) -> pd.DataFrame:
         if box is not None:        # a record of another shot: its plateau is another impact velocity's
             check_plateau(rows[-1], box, f"shot {shot}: {where}", config["checks"]["plateau_vs_velocity"])
     return pd.DataFrame(rows)[["shot", "source", *COLUMNS, *READOUT_COLUMNS, *RECORD_NOISE_COLUMNS]]
+
+
+def command_settings(config: dict):
+    """`simulator.command` as `CommandSettings` (its output as `OutputSpec`)."""
+    from shockcal.simulators.command import CommandSettings
+    from shockcal.simulators.outputs import OutputSpec
+
+    section = config["simulator"]["command"]
+    return CommandSettings(tuple(section["templates"]), section["command"], OutputSpec(**section["output"]),
+                           float(section["timeout_s"]), int(section["retries"]), dict(section["env"]))
+
+
+def archive_source(config: dict, shot: str):
+    """`simulator.archive` for `shot`: its features table's path, or its traces pattern with their `OutputSpec`
+    (`ArchiveSource`), paths resolved (`shockcal.study.simulator.resolve_path`)."""
+    from shockcal.errors import ConfigError
+    from shockcal.simulators.archive import ArchiveSource
+    from shockcal.simulators.outputs import OutputSpec
+    from shockcal.study.simulator import resolve_path
+
+    section = config["simulator"]["archive"]
+    design = resolve_path(section["design"], "simulator.archive.design")
+    if shot in section.get("features", {}):
+        return ArchiveSource(design, features=resolve_path(section["features"][shot], f"simulator.archive.features.{shot}"))
+    if shot not in section.get("traces", {}):
+        raise ConfigError(f"simulator.archive: no runs of {shot} (neither features.{shot} nor traces.{shot}); an archive "
+                          "holds the training runs of the study's shots only")
+    pattern = section["traces"][shot]
+    resolved = resolve_path(pattern, f"simulator.archive.traces.{shot}")
+    return ArchiveSource(design, traces=str(resolved), trace=OutputSpec(**{**section.get("trace", {}), "kind": "trace",
+                                                                            "file": Path(pattern).name}))

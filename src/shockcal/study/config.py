@@ -27,10 +27,15 @@ def end_time_us(config: dict, shot: dict) -> float:
     requested = config["hydro"]["end_time_us"]
     if requested != "auto":
         return float(requested)
+    return analysis_end_us(config, shot) + AUTO_END_MARGIN_US
+
+
+def analysis_end_us(config: dict, shot: dict) -> float:
+    """The latest time after impact (us) the analysis window of `shot` (a shot's config section) can
+    end: target / c0 (the free surface starts to move no later) plus `window_after_arrival_us`."""
     material = config["material"]
     c0_cm_us = math.sqrt(material["eos"]["c1_Mbar"] / material["rho0_g_cc"])
-    window = shot["analysis"]["window_after_arrival_us"]
-    return shot["target_mm"] * MM_TO_CM / c0_cm_us + window + AUTO_END_MARGIN_US
+    return shot["target_mm"] * MM_TO_CM / c0_cm_us + shot["analysis"]["window_after_arrival_us"]
 
 
 def input_names(config: dict) -> list[str]:

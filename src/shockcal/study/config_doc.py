@@ -21,7 +21,9 @@ DOC_PATH = Path("docs") / "configuration.md"   # relative to the repository root
 # how a key of a free-form mapping (`additionalProperties`) is written in a key path
 PLACEHOLDERS = {"shots": "<shot>", "inputs": "<input>", "observed.features": "<shot>", "observed.records": "<shot>",
                 "calibration.cube_power": "<input>", "strength.inputs": "<parameter>",
-                "next_shot.candidates": "<candidate>", "next_shot.readout_sd_m_s": "<feature>"}
+                "next_shot.candidates": "<candidate>", "next_shot.readout_sd_m_s": "<feature>",
+                "simulator.command.env": "<variable>", "simulator.archive.features": "<shot>",
+                "simulator.archive.traces": "<shot>"}
 # unit suffixes of key names (shockcal's "units in names"), longest match first
 UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K"), ("_g_cc", "g/cc"), ("_Mbar", "Mbar"), ("_mm", "mm"),
                  ("_um", "um"), ("_us", "us"), ("_ns", "ns"), ("_K", "K"))

@@ -33,12 +33,13 @@ _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
-    "design": ("study.seed", "design", "inputs", "checks.design_box", *_SHOT_MAPPING),
+    "design": ("study.seed", "design", "inputs", "checks.design_box", "simulator.kind?", "simulator.archive?",
+               *_SHOT_MAPPING),
     # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
     "check_design": ("study.seed", "inputs", "calibration.check.trials", "design.base_shots", "checks.design_box",
                      *_SHOT_MAPPING),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto
-    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?",
+    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?", "simulator?",
                  *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
                  "shots.{shot}.analysis.window_after_arrival_us"),
     # features of one shot's traces (one chunk, or a whole run set with the failure budget)
@@ -68,7 +69,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # a next-shot candidate's design: the joint posterior's draws with the new shot's nuisance inputs
     "next_shot_design": ("study.seed", "next_shot.n_draws", *_CANDIDATE_BOX, *_CANDIDATE),
     # a candidate's hydrocode runs and their features
-    "next_shot_simulate": ("hydro", *_CANDIDATE_BOX, *_CANDIDATE),
+    "next_shot_simulate": ("hydro", "simulator?", *_CANDIDATE_BOX, *_CANDIDATE),
     "next_shot_features": ("features", *_CANDIDATE),
     # the candidates' information gains and their ranking
     "suggest_shot": ("study.seed", "next_shot.candidates", "next_shot.targets", "next_shot.emulator_error",

@@ -44,6 +44,7 @@
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -369,7 +370,8 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
     reason and the ten features.
 
     Failed simulations keep their status and reason; a trace the extractor cannot read becomes
-    status "failed" with the extractor's reason. A table that is not a simulations table (columns
+    status "failed" with the extractor's reason. A row that carries the ten features and no trace (an
+    external code's or an archive's features) keeps them as they are. A table that is not a simulations table (columns
     missing, no rows, run ids that are not whole numbers, traces that are not lists of numbers: a CSV
     copy of a chunk) is an InputError naming `source` and the run.
     """
@@ -384,7 +386,9 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
     rows = []
     for record in traces.to_dict("records"):
         row = {"run": int(record["run"]), "status": record["status"], "reason": record["reason"]}
-        if record["status"] == "ok":
+        if record["status"] == "ok" and _given_features(record):
+            row.update({column: record[column] for column in COLUMNS})
+        elif record["status"] == "ok":
             t, v = (_trace_column(record, column, source) for column in ("t_us", "v_m_s"))
             try:
                 row.update(extract_features(t, v, settings))
@@ -395,6 +399,12 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
+
+
+def _given_features(record: dict) -> bool:
+    """Whether a simulations row carries its run's features instead of a trace (an external code that
+    extracts its own, an archive of features: `shockcal.simulators`)."""
+    return all(column in record for column in COLUMNS) and len(record["t_us"]) == 0
 
 
 def _trace_column(record: dict, column: str, source) -> np.ndarray:
@@ -454,8 +464,9 @@ def _column(value):
 
 
 def check_failures(table, max_fraction: float, shot: str) -> None:
-    """Log the excluded count; stop when more than `max_fraction` of the runs failed, or when there are
-    no runs (or no `status` column: not a features table)."""
+    """Log the excluded count and their reasons; stop in one line naming the shot, the count and the commonest
+    reason (`reason_kind`) when more than `max_fraction` of the runs failed, or when there are no runs (or
+    no `status` column: not a features table)."""
     from shockcal.io import require_columns
 
     require_columns(table, ["run", "status", "reason"], f"features of shot {shot}")
@@ -465,8 +476,20 @@ def check_failures(table, max_fraction: float, shot: str) -> None:
     if failed.empty:
         log.info("shot %s: all %d runs have features", shot, len(table))
         return
-    log.warning("shot %s: %d of %d runs failed and are excluded downstream", shot, len(failed), len(table))
+    kinds = failed["reason"].astype(str).map(reason_kind).value_counts()
+    log.warning("shot %s: %d of %d runs failed and are excluded downstream; by reason: %s", shot, len(failed),
+                len(table), "; ".join(f"{kind} ({count})" for kind, count in kinds.items()))
+    for r in failed.head(10).itertuples():
+        log.warning("  run %s: %s", r.run, r.reason)
     if len(failed) > max_fraction * len(table):
-        worst = "\n".join(f"  run {r.run}: {r.reason}" for r in failed.head(10).itertuples())
+        commonest = kinds.index[0]
+        example = failed[failed["reason"].astype(str).map(reason_kind) == commonest].iloc[0]
         raise ShockcalError(f"shot {shot}: {len(failed)} of {len(table)} runs failed, more than the allowed "
-                            f"{max_fraction:.0%} (simulate.max_failed_fraction); the first:\n{worst}")
+                            f"{max_fraction:.0%} (simulate.max_failed_fraction); the commonest reason, "
+                            f"{kinds.iloc[0]} runs: {commonest} (e.g. run {example['run']}: {example['reason']})")
+
+
+def reason_kind(reason: str) -> str:
+    """What a failed run's reason says without its particulars: the text before its first ':', numbers as #
+    ("nonzero exit", "output truncated", "negative cell volume in cell # (target) at t = # us after # steps")."""
+    return re.sub(r"[-+]?\d+(\.\d*)?([eE][-+]?\d+)?", "#", reason.split(":")[0].strip()) or "(no reason given)"
