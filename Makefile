@@ -10,7 +10,7 @@ LOCKED_PYTHON := 3.11
 CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: study quick flag-archive models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 $(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -26,6 +26,9 @@ study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
 	snakemake --cores $(CORES) all --configfile config/quick.yaml
+
+flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design and features) through the workflow, no hydrocode, into results/flag-archive
+	snakemake --cores $(CORES) all --configfile config/flag-archive.yaml
 
 # the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
 # posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files

@@ -9,6 +9,7 @@ from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
 from shockcal.study.next_shot_check import plan_check
+from shockcal.study.simulator import simulator_kind
 from shockcal.study.stages import figure_config, stage_config
 from shockcal.study.workflow import (
     chunk_count,
@@ -29,6 +30,9 @@ write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
 export_to_jobs(EFFECTIVE_CONFIG)
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
+# an archive study (simulator.kind archive, docs/simulators.md) has its training runs and no code to run
+# others: the posterior's predictive runs (the run set predict) and what reads them are left out of `all`
+ARCHIVE_STUDY = simulator_kind(config) == "archive"
 
 LOGS = f"{RESULTS}/logs"
 BENCHMARKS = f"{RESULTS}/benchmarks"

@@ -64,10 +64,13 @@ for _name, _spec in FIGURE_SPECS.items():
             "shockcal figures --figure {params.figure} --out-dir {params.out_dir}" " {params.inputs} > {log} 2>&1"
 
 
+# the input kinds an archive study cannot make (hydrocode traces, posterior predictive runs)
+RUN_INPUT_KINDS = {"sample_simulations", "simulations", "predicted_simulations", "predicted_features"}
 ALL_TARGETS.extend(
     f"{RESULTS}/figures/{name}.{fmt}"
     for name, spec in FIGURE_SPECS.items()
     if spec.target == "all"
+    and not (ARCHIVE_STUDY and any(key.partition(":")[0] in RUN_INPUT_KINDS for key in spec.needs))
     for fmt in FIGURE_FORMATS
 )
 # the figures of other targets (next_shot), by target

@@ -49,7 +49,9 @@ rule posterior_netcdf:
         samples=rules.calibrate.output.samples,
         weighted=rules.calibrate.output.weighted,
         predicted=lambda w: (
-            expand(rules.features.output[0], run_set="predict", shot=SHOTS) if w.name == "joint" else []
+            expand(rules.features.output[0], run_set="predict", shot=SHOTS)
+            if w.name == "joint" and not ARCHIVE_STUDY
+            else []
         ),
     output:
         f"{RESULTS}/posterior/{{name}}.nc",
