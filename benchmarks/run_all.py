@@ -14,8 +14,9 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-TYPICAL_S = {"bench_calibration.py": 150, "bench_emulator.py": 60, "bench_features.py": 40, "bench_hydro.py": 30,
-             "bench_likelihood.py": 170, "bench_rate_sensitivity.py": 20}   # seconds on 2 idle cores; unknown ones count 60
+TYPICAL_S = {"bench_calibration.py": 150, "bench_command_simulator.py": 15, "bench_emulator.py": 60,
+             "bench_features.py": 40, "bench_hydro.py": 30, "bench_likelihood.py": 170,
+             "bench_rate_sensitivity.py": 20}   # seconds on 2 idle cores; unknown ones count 60
 
 
 def _duration(seconds: float) -> str:
