@@ -156,3 +156,24 @@ def test_a_killed_job_resumes_without_rerunning_finished_runs(paper_config, tmp_
     assert main(args) == 0
     assert done.stat().st_mtime_ns == first
     assert pd.read_parquet(tmp_path / "chunk.parquet")["status"].tolist() == ["ok", "ok"]
+
+
+@pytest.mark.parametrize("value, status, reason", [
+    (None, "ok", ""),
+    ("nan", "failed", "output non-finite: features.csv: v_jumpoff, v_elastic, v_plastic"),
+    ("0.02", "failed", "output units: features.csv: the largest velocity feature"),
+])
+def test_a_code_that_writes_its_own_features(paper_config, tmp_path, value, status, reason):
+    """`output.kind: features`: the row's features reach the features table as they are."""
+    from shockcal.velocimetry.features import COLUMNS, ExtractorSettings, features_table
+
+    features = dict(paper_config["observed"]["features"][SHOT])
+    if value is not None:
+        features.update({name: value for name in features if name.startswith("v_")})
+    header, row = ",".join(features), ",".join(str(v) for v in features.values())
+    config = command_config(paper_config, f"printf '{header}\\n{row}\\n' > features.csv",
+                            output={"kind": "features", "file": "features.csv"})
+    table = features_table(run_command(config, design(config, 1), tmp_path), ExtractorSettings())
+    assert table["status"].tolist() == [status] and table["reason"].iloc[0].startswith(reason)
+    if status == "ok":
+        assert table[COLUMNS].iloc[0].tolist() == [features[c] for c in COLUMNS]
