@@ -8,7 +8,7 @@ name (`A_MPa`, `V1_m_s`), and `user_columns` does all three for a table's column
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 
 MM_TO_CM = 0.1
 UM_TO_CM = 1.0e-4
@@ -40,6 +40,11 @@ def user_unit(unit: str, modulus: bool = False) -> str:
     if unit not in PAPER_UNITS:
         return unit
     return ("GPa" if modulus else "MPa") if unit in PRESSURE_IN_MPA else "m/s"
+
+
+def user_units(units: Mapping[str, str], moduli: Collection[str] = ()) -> dict[str, str]:
+    """Each name of `units` (name -> declared unit) -> its `user_unit`, `moduli` naming the moduli."""
+    return {name: user_unit(unit, modulus=name in moduli) for name, unit in units.items()}
 
 
 def unit_factor(unit: str, to: str) -> float:

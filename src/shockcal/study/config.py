@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from shockcal.errors import ConfigError
-from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S, user_columns, user_unit
+from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S, user_columns, user_units
 
 AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
 
@@ -48,7 +48,7 @@ def input_user_units(config: dict) -> dict[str, str]:
     input (a shot's `shear_modulus_inputs`) in Mbar reads in GPa, another pressure (a stress) in MPa, a
     velocity in m/s; MPa, GPa, m/s and dimensionless inputs as declared."""
     moduli = {name for shot in config["shots"].values() for name in shot["shear_modulus_inputs"]}
-    return {name: user_unit(box["unit"], modulus=name in moduli) for name, box in config["inputs"].items()}
+    return user_units({name: box["unit"] for name, box in config["inputs"].items()}, moduli)
 
 
 def input_columns(config: dict) -> dict[str, tuple[str, str, float]]:
