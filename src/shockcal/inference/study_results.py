@@ -42,10 +42,10 @@ class StudyResults:
     observed: pd.DataFrame
 
     def __repr__(self) -> str:
-        runs = sum(len(block.runs) for block in self.emulator.blocks)
+        runs = "; ".join(f"{len(block.runs)} training runs of {'+'.join(block.shots)}" for block in self.emulator.blocks)
         lines = [f"StudyResults({str(self.results_dir)!r}): shots {', '.join(self.shots)}",
-                 f"  emulator: {self.emulator.structure}, {runs} training runs, "
-                 f"{len(self.emulator.feature_names)} features per shot ({', '.join(self.emulator.feature_names)}, m/s)",
+                 f"  emulator ({self.emulator.structure}): {runs}; {len(self.emulator.feature_names)} features per shot "
+                 f"({', '.join(self.emulator.feature_names)}, m/s)",
                  f"  observed: {len(self.observed)} shots' measured features (features/observed.parquet)",
                  f"  {'posterior':<10} {'draws':>6} {'weighted':>9} {'Kish ESS':>9}  log Z"]
         for name, posterior in self.posteriors.items():
@@ -76,8 +76,10 @@ def load_study(results_dir) -> StudyResults:
               *(root / "posterior" / f"{shot}.parquet" for shot in shots)]
     missing = [str(path.relative_to(root)) for path in dict.fromkeys(needed) if not path.is_file()]
     if missing:
+        below = [str(d) for d in sorted(root.iterdir()) if (d / "posterior" / f"{JOINT}.parquet").is_file()]
+        hint = f"; studies below it: {', '.join(below)}" if below else ""
         raise InputError(f"{root}: not a finished study ({', '.join(missing)} missing; run the workflow into it, "
-                         "e.g. `make quick` for results/quick)")
+                         f"e.g. `make quick` for results/quick){hint}")
     observed = read_table(root / "features" / "observed.parquet")
     return StudyResults(root, shots, {name: read_posterior(root / "posterior" / f"{name}.parquet") for name in names},
                         {name: az.from_netcdf(root / "posterior" / f"{name}.nc") for name in names},
