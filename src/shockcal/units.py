@@ -69,11 +69,12 @@ def unit_name(name: str, unit: str) -> str:
     return name if name.endswith(f"_{suffix}") else f"{name}_{suffix}"
 
 
-def user_columns(units: Mapping[str, str], user_units: Mapping[str, str]) -> dict[str, tuple[str, str, float]]:
+def user_columns(units: Mapping[str, str], to_units: Mapping[str, str]) -> dict[str, tuple[str, str, float]]:
     """Each name of `units` (name -> declared unit) -> (its name for a user, its user unit, the factor to
-    it): the user unit from `user_units` (absent: the declared one), the name from `unit_name`."""
+    it): the user unit from `to_units` (absent: the declared one; `user_units` gives them), the name from
+    `unit_name`."""
     out = {}
     for name, unit in units.items():
-        to = user_units.get(name, unit)
+        to = to_units.get(name, unit)
         out[name] = (unit_name(name, to), to, unit_factor(unit, to))
     return out
