@@ -1,8 +1,9 @@
 """The Snakemake workflow on the quick study: every figure from one command, partial reruns decided
 by config slices (not mtimes), and an interrupted fan-out finishing with identical results.
 
-One quick study (config/quick.yaml, about a minute on 2 idle cores) is run into a temporary results
-directory and shared by the tests of this module; the rerun checks are dry runs against it.
+One quick study (config/quick.yaml, about two minutes on 2 idle cores) is run into a temporary results
+directory and shared by the tests of the session (`quick_study`, tests/conftest.py); the rerun checks
+are dry runs against it.
 """
 
 from __future__ import annotations
@@ -66,14 +67,10 @@ def pending_jobs(*config_files, target="all") -> dict[str, int]:
     return jobs
 
 
-@pytest.fixture(scope="module")
-def study(tmp_path_factory):
-    """The quick study run once, end to end: (results directory, its config overlay)."""
-    root = tmp_path_factory.mktemp("quick")
-    results = root / "results"
-    config = overlay(root / "results.yaml", study={"results_dir": str(results)})
-    snakemake("all", "--cores", "2", config_files=[config])
-    return results, config
+@pytest.fixture
+def study(quick_study):
+    """The session's quick study (tests/conftest.py): (results directory, its config overlay)."""
+    return quick_study
 
 
 def test_every_figure_is_a_real_image(study):

@@ -2,9 +2,10 @@
 (coverage on synthetic truth) and `shockcal coverage` (merging the check's batches).
 
 calibrate reads the emulator directory and the observed features table and writes OUT (equal-weight
-draws), OUT_summary.parquet and OUT_weighted.parquet (the sampler's weighted draws with their log
-weights: the exact result); config keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`,
-`inputs`, study.seed (shockcal.study.stages declares them)."""
+draws, native units), OUT_summary.parquet (in MPa, GPa and m/s) and OUT_weighted.parquet (the sampler's
+weighted draws with their log weights: the exact result; `shockcal.inference.posterior_files`); config
+keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`, `inputs`, study.seed
+(shockcal.study.stages declares them)."""
 
 from __future__ import annotations
 
@@ -61,19 +62,12 @@ def study_emulator(directory, config: dict):
     return emulator
 
 
-def companion_path(out, kind: str = "summary"):
-    """The table of `kind` ("summary", "weighted") beside the posterior samples `out`."""
-    from pathlib import Path
-
-    out = Path(out)
-    return out.with_name(f"{out.stem}_{kind}.parquet")
-
-
 def run(args) -> int:
     import logging
 
     from shockcal.inference.calibration import calibrate
-    from shockcal.io import read_table, write_table
+    from shockcal.inference.posterior_files import write_posterior
+    from shockcal.io import read_table
     from shockcal.study.adapters import calibration_settings
     from shockcal.study.stages import load_stage_config
 
@@ -85,21 +79,12 @@ def run(args) -> int:
     if args.n_eff is not None:
         settings = settings.with_sampler(n_eff=args.n_eff)
     posterior = calibrate(emulator, args.shots, observed, settings, source=args.observed)
-    info, summary = posterior.info(), posterior.summary()
-    meta = {"table": "posterior samples", **info,
-            "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
-                       "log_likelihood (at the draw)"}
-    write_table(posterior.draws, args.out, meta)
-    write_table(summary, companion_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
-    write_table(posterior.weighted_table(), companion_path(args.out, "weighted"),
-                {**meta, "table": "posterior weighted draws",
-                 "columns": "nautilus's weighted draws (the exact result): inputs in `units`; lambda_y (-); log_weight "
-                            "(normalised, logsumexp = 0); log_likelihood"})
+    info = write_posterior(posterior, args.out)
     logging.getLogger("shockcal.calibrate").info(
         "posterior of %s (Kish ESS %.0f, %d draws written, %d distinct, %d likelihood evaluations, "
         "log evidence %.3f +- %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(posterior.draws),
         info["distinct_draws"], info["likelihood_evaluations"], info["log_evidence"], info["log_evidence_sd"],
-        summary.to_string(index=False, float_format="%.4g"))
+        posterior.summary().to_string(index=False, float_format="%.4g"))
     return 0
 
 

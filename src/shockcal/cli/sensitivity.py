@@ -2,7 +2,7 @@
 and over the box of the joint posterior's 5-95% quantiles (shockcal.campaign.sensitivity says why a box).
 
 Config keys: `sensitivity` (n_base, resamples), `inputs` (the prior box), study.seed (the
-`sensitivity` stream)."""
+`sensitivity` stream), the shots' shear-modulus inputs (which summary rows are moduli, in GPa)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def run(args) -> int:
     from shockcal.emulator.study_emulator import Emulator
     from shockcal.io import atomic_path, read_table, write_table
     from shockcal.seeds import stream_seed
-    from shockcal.study.config import prior_bounds
+    from shockcal.study.config import input_columns, prior_bounds
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "sensitivity")
@@ -44,7 +44,7 @@ def run(args) -> int:
     domains = {"prior": prior}
     if args.posterior_summary:
         names = [k for k in prior if k in emulator.required_inputs(emulator.shots)]
-        domains["posterior_q05_q95"] = posterior_box(read_table(args.posterior_summary), names)
+        domains["posterior_q05_q95"] = posterior_box(read_table(args.posterior_summary), names, input_columns(config))
     log = logging.getLogger("shockcal.campaign.sensitivity")
     parts = []
     for domain, bounds in domains.items():
