@@ -9,11 +9,22 @@ keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`, `inputs`, 
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs, parse_span, unique_shots
+from shockcal.cli import add_command, add_config_argument, parse_pairs, parse_span, unique_shots
+
+EXAMPLE_CALIBRATE = """\
+shockcal calibrate --config config/config.yaml --emulator results/emulator --shots 104S 105S 106S \\
+    --observed results/features/observed.parquet --out results/posterior/joint.parquet"""
+EXAMPLE_CALIBRATE_CHECK = """\
+shockcal calibrate-check --config config/config.yaml --emulator results/emulator --shots 104S \\
+    --trials 10 --out results/check/104S_trials.parquet"""
+EXAMPLE_COVERAGE = """\
+shockcal coverage --trials results/check/coverage/emulator/batch-*.parquet \\
+    --out results/posterior/coverage_emulator.parquet"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("calibrate", help="posterior of the inputs given measured features (nested sampling)")
+    p = add_command(subparsers, "calibrate", example=EXAMPLE_CALIBRATE,
+                    help="posterior of the inputs given measured features (nested sampling)")
     add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
@@ -23,7 +34,8 @@ def register(subparsers) -> None:
     p.add_argument("--n-eff", type=int, help="override calibration.n_eff (effective sample size to reach)")
     p.set_defaults(func=run)
 
-    c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
+    c = add_command(subparsers, "calibrate-check", example=EXAMPLE_CALIBRATE_CHECK,
+                    help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
     add_config_argument(c)
     c.add_argument("--emulator", required=True)
     c.add_argument("--shots", required=True, nargs="+")
@@ -43,7 +55,8 @@ def register(subparsers) -> None:
     c.add_argument("--draws-out", help="also write every trial's equal-weight posterior draws (Parquet; trial, run)")
     c.set_defaults(func=run_check)
 
-    m = subparsers.add_parser("coverage", help="merge per-trial tables of calibrate-check batches; print the coverage")
+    m = add_command(subparsers, "coverage", example=EXAMPLE_COVERAGE,
+                    help="merge per-trial tables of calibrate-check batches; print the coverage")
     m.add_argument("--trials", required=True, nargs="+", help="per-trial tables (calibrate-check --out)")
     m.add_argument("--out", required=True, help="merged per-trial table (Parquet)")
     m.set_defaults(func=run_coverage)

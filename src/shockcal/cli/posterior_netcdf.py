@@ -10,11 +10,16 @@ Config keys: the `calibrate` stage's (the prior box; their sha256 is the file's 
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_command, add_config_argument, parse_pairs
+
+EXAMPLE_POSTERIOR_NETCDF = """\
+shockcal posterior-netcdf --config config/config.yaml --posterior results/posterior/joint.parquet \\
+    --out results/posterior/joint.nc"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("posterior-netcdf", help="a posterior as ArviZ InferenceData (netCDF) with provenance")
+    p = add_command(subparsers, "posterior-netcdf", example=EXAMPLE_POSTERIOR_NETCDF,
+                    help="a posterior as ArviZ InferenceData (netCDF) with provenance")
     add_config_argument(p)
     p.add_argument("--posterior", required=True,
                    help="equal-weight posterior draws (shockcal calibrate --out); *_weighted.parquet is read beside it")

@@ -12,11 +12,16 @@ only when its inputs are given. No config is read.
 
 from __future__ import annotations
 
-from shockcal.cli import parse_pairs
+from shockcal.cli import add_command, parse_pairs
+
+EXAMPLE_REPORT_TABLES = """\
+shockcal report-tables --posteriors joint=results/posterior/joint.parquet \\
+    --cv-rmse results/emulator/cv_rmse.csv --out-dir results/report"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("report-tables", help="summary tables (CSV) of posteriors, evidence, CV and coverage "
+    p = add_command(subparsers, "report-tables", example=EXAMPLE_REPORT_TABLES,
+                    help="summary tables (CSV) of posteriors, evidence, CV and coverage "
                                                     "for the report")
     p.add_argument("--posteriors", nargs="+", default=[], metavar="NAME=POSTERIOR",
                    help="calibrations' equal-weight draws (shockcal calibrate --out); their _summary.parquet is read")

@@ -6,11 +6,16 @@ Config keys: `sensitivity` (n_base, resamples), `inputs` (the prior box), study.
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_SENSITIVITY = """\
+shockcal sensitivity --config config/config.yaml --emulator results/emulator \\
+    --posterior-summary results/posterior/joint_summary.parquet --out results/sensitivity/sobol.csv"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("sensitivity", help="Sobol indices of the emulated features over the prior and posterior")
+    p = add_command(subparsers, "sensitivity", example=EXAMPLE_SENSITIVITY,
+                    help="Sobol indices of the emulated features over the prior and posterior")
     add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--posterior-summary", help="the joint posterior's summary (q05, q95 per input): adds the "
