@@ -1,4 +1,4 @@
-# shockcal: `make study` runs the paper's study, `make test` the tests. Both create .venv first.
+# shockcal: `make help` lists the targets; `make env` creates .venv and installs, and every other target does so first.
 SHELL := /bin/bash
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -14,7 +14,7 @@ export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 # it would print in RESULTS_DIR/logs/snakemake/<start time>.log (the logger plugin shockcal, docs/workflow.md):
 # $(call snakemake,RESULTS_DIR). VERBOSE=1 (`make quick VERBOSE=1`) prints snakemake's own output instead.
 VERBOSE ?=
-snakemake = snakemake $(if $(VERBOSE),,--logger shockcal --logger-shockcal-log-dir $(1)/logs/snakemake)
+snakemake = snakemake$(if $(filter-out 0,$(VERBOSE)),, --logger shockcal --logger-shockcal-log-dir $(1)/logs/snakemake)
 
 # $(call study,RESULTS_DIR,SNAKEMAKE_ARGS): a whole study, its HTML report and its time per stage
 # (RESULTS_DIR/stage_times.txt), then where they are

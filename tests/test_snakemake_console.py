@@ -105,7 +105,7 @@ def test_off_a_terminal_a_line_comes_every_interval_with_the_time_left(monkeypat
     monkeypatch.setattr(snakemake_console.time, "monotonic", lambda: now[0])
     stream = io.StringIO()
     monkeypatch.setattr(snakemake_console.sys, "stderr", stream)
-    handler = LogHandler(SimpleNamespace(dryrun=False), LogHandlerSettings())
+    handler = LogHandler(SimpleNamespace(dryrun=False, stdout=False), LogHandlerSettings())
     handler.closed.set()                                        # no ticker thread: the test calls its step
     handler.setFormatter(logging.Formatter("%(message)s"))
     handler.handle(recorded(LogEvent.RUN_INFO, msg="Job stats: ...", stats={"make": 66, "all": 1, "total": 67}))
@@ -119,7 +119,6 @@ def test_off_a_terminal_a_line_comes_every_interval_with_the_time_left(monkeypat
 
 def test_the_line_reads_in_minutes_and_hours():
     assert clock(59.6) == "01:00" and clock(3725) == "1:02:05"
-    assert progress_line(None, None, 5) == "snakemake: planning the jobs, 00:05 elapsed"
     assert progress_line(0, 67, 5) == "snakemake: 0/67 jobs, 00:05 elapsed"
     assert progress_line(10, 40, 60) == "snakemake: 10/40 jobs, 01:00 elapsed, ~03:00 left"
     assert final_line(12, 67, 30, failed=True) == "snakemake: 12/67 jobs done in 00:30, stopped by the error above"

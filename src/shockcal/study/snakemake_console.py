@@ -20,6 +20,7 @@ Snakemake's plugin registry (a plugin is found by that package name).
 
 import datetime
 import logging
+import shutil
 import sys
 import threading
 import time
@@ -35,7 +36,8 @@ LINE_INTERVAL_S = 30.0   # a progress line this often when stderr is not a termi
 REDRAW_S = 1.0           # the line's redraw on a terminal
 LOG_TAIL_LINES = 5       # the last lines of a failed job's log files shown on the console
 ERROR_EVENTS = (LogEvent.JOB_ERROR, LogEvent.GROUP_ERROR)
-NOTHING_TO_DO = "Nothing to be done"
+SHOWN_INFO = ("Nothing to be done", "Terminating processes on user request")   # snakemake's info lines shown
+SNAKEMAKES_LOG = "Complete log(s):"   # the path of snakemake's own log, shown when there is no log of ours
 
 
 @dataclass
@@ -53,10 +55,8 @@ def clock(seconds: float) -> str:
     return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:02d}:{secs:02d}"
 
 
-def progress_line(done: int | None, total: int | None, elapsed_s: float) -> str:
+def progress_line(done: int | None, total: int, elapsed_s: float) -> str:
     """The console's line: jobs done of the total, time elapsed and the time left at the pace so far."""
-    if total is None:
-        return f"snakemake: planning the jobs, {clock(elapsed_s)} elapsed"
     done = done or 0
     line = f"snakemake: {done}/{total} jobs, {clock(elapsed_s)} elapsed"
     if 0 < done < total:
@@ -86,13 +86,13 @@ class LogHandler(LogHandlerBase):
     """One progress line and the failures on stderr, everything in the log file (module docstring)."""
 
     def __post_init__(self) -> None:
-        self.stream = sys.stderr
+        self.stream = sys.stdout if self.common_settings.stdout else sys.stderr    # where snakemake would print
         self.terminal = self.stream.isatty()
         self.started = time.monotonic()
         self.done: int | None = None
         self.total: int | None = None
         self.failed = False
-        self.line_shown = False        # a progress line is on the console (to end with a newline)
+        self.line_shown = False        # a progress line is on a terminal (to be wiped before other lines)
         self.lock = threading.RLock()
         self.log_path = None
         self.log = None
@@ -151,7 +151,8 @@ class LogHandler(LogHandlerBase):
                 self.failed = True
                 self._print(text)
                 self._print("\n".join(log_tail(getattr(record, "log", None) or [])))
-            elif record.levelno >= logging.WARNING or str(record.msg).startswith(NOTHING_TO_DO):
+            elif (record.levelno >= logging.WARNING or str(record.msg).startswith(SHOWN_INFO)
+                  or (self.log is None and str(record.msg).startswith(SNAKEMAKES_LOG))):
                 self.failed = self.failed or record.levelno >= logging.ERROR
                 self._print(text)
 
@@ -160,7 +161,7 @@ class LogHandler(LogHandlerBase):
             if not self.closed.is_set():
                 self.closed.set()
                 if self.total is not None and not self.common_settings.dryrun:
-                    self._end_line()
+                    self._clear_line()
                     self._print(final_line(self.done, self.total, time.monotonic() - self.started, self.failed))
                 if self.log is not None:
                     self.log.close()
@@ -172,28 +173,29 @@ class LogHandler(LogHandlerBase):
         interval = REDRAW_S if self.terminal else LINE_INTERVAL_S
         while not self.closed.wait(interval):
             with self.lock:
-                if not self.closed.is_set():
+                if not self.closed.is_set() and self.total is not None:     # not while planning, nor for --report
                     self._redraw(new_line=not self.terminal)
 
     def _redraw(self, new_line: bool) -> None:
         """The progress line: in place on a terminal, as a new line otherwise when `new_line`."""
         line = progress_line(self.done, self.total, time.monotonic() - self.started)
-        if self.terminal:
-            self.stream.write(f"\r{line}\x1b[K")
+        if self.terminal:     # cut to the terminal's width: a wrapped line would not redraw in place
+            self.stream.write(f"\r{line[:shutil.get_terminal_size().columns - 1]}\x1b[K")
             self.line_shown = True
         elif new_line:
             self.stream.write(line + "\n")
         self.stream.flush()
 
-    def _end_line(self) -> None:
+    def _clear_line(self) -> None:
+        """The progress line wiped, for other lines in its place."""
         if self.line_shown:
-            self.stream.write("\n")
+            self.stream.write("\r\x1b[K")
             self.line_shown = False
 
     def _print(self, text: str) -> None:
-        """Lines above the progress line (which a terminal then redraws below them)."""
+        """Lines in the progress line's place (a terminal redraws it below them at the next tick)."""
         if not text:
             return
-        self._end_line()
+        self._clear_line()
         self.stream.write(text.rstrip("\n") + "\n")
         self.stream.flush()
