@@ -63,7 +63,7 @@ def test_a_run_shows_its_progress_on_a_line_and_every_job_block_in_the_log(finis
     folder, done = finished
     lines = console_lines(done)
     assert done.returncode == 0, lines
-    assert lines[-2].startswith("snakemake: 8/8 jobs done in ") and "stopped" not in lines[-2], lines
+    assert lines[-2].startswith("snakemake: 8/8 jobs done in ") and "failed" not in lines[-2], lines
     (log_path,) = (folder / "results" / "logs" / "snakemake").glob("*.log")
     assert lines[-1] == f"snakemake log: {log_path}"
     assert len(lines) == 2, lines                               # piped, a run of seconds: no 30 s line
@@ -79,7 +79,7 @@ def test_a_failure_shows_the_rule_its_log_and_snakemakes_error_and_keeps_the_exi
     assert "last lines of logs/last.log:" in console
     assert "    shockcal features: error: out/0.txt: no column t_us" in console        # the job's own message
     assert "At least one job did not complete successfully." in console               # snakemake's error line
-    assert "stopped by the error above" in console_lines(done)[-2]
+    assert "failed (the errors above)" in console_lines(done)[-2]
     assert "localrule make:" not in console and "localrule make:" in the_log(tmp_path)
 
 
@@ -121,6 +121,6 @@ def test_the_line_reads_in_minutes_and_hours():
     assert clock(59.6) == "01:00" and clock(3725) == "1:02:05"
     assert progress_line(0, 67, 5) == "snakemake: 0/67 jobs, 00:05 elapsed"
     assert progress_line(10, 40, 60) == "snakemake: 10/40 jobs, 01:00 elapsed, ~03:00 left"
-    assert final_line(12, 67, 30, failed=True) == "snakemake: 12/67 jobs done in 00:30, stopped by the error above"
+    assert final_line(12, 67, 30, failed=True) == "snakemake: 12/67 jobs done in 00:30; failed (the errors above)"
 
 

@@ -1,6 +1,6 @@
 """Snakemake's console at one line of progress: the logger plugin `snakemake --logger shockcal` (what `make` runs).
 
-On the console (stderr), instead of a block per job:
+On the console (stderr; stdout for a dry run, as snakemake), instead of a block per job:
 
 - one line, redrawn in place on a terminal (every second) and written anew every `LINE_INTERVAL_S` seconds
   otherwise (a pipe, a CI log), e.g. ``snakemake: 37/67 jobs, 01:12 elapsed, ~01:30 left``; the time left
@@ -65,16 +65,16 @@ def progress_line(done: int | None, total: int, elapsed_s: float) -> str:
 
 
 def final_line(done: int | None, total: int, elapsed_s: float, failed: bool) -> str:
-    """The console's last word on the run: the jobs done and the time taken, and whether it stopped on an error."""
+    """The console's last word on the run: the jobs done and the time taken, and whether it failed."""
     line = f"snakemake: {done or 0}/{total} jobs done in {clock(elapsed_s)}"
-    return line + ", stopped by the error above" if failed else line
+    return line + "; failed (the errors above)" if failed else line
 
 
 def log_tail(paths, n_lines: int = LOG_TAIL_LINES) -> list[str]:
     """The last `n_lines` lines of each existing file in `paths`, under a header naming it."""
     lines = []
     for path in paths:
-        path = Path(str(path).split(" ")[0])       # snakemake may append "(check log file(s) ...)"
+        path = Path(str(path).split(" (")[0])       # without a note snakemake may append, " (...)"
         if not path.is_file():
             continue
         text = path.read_text(errors="replace").rstrip("\n").splitlines()[-n_lines:]
