@@ -1,4 +1,4 @@
-# shockcal: `make help` lists the targets; `make env` creates .venv and installs, and every other target does so first.
+# shockcal: `make help` lists the targets (also what a bare `make` does); `make env` creates .venv and installs, as every target that runs shockcal does first.
 SHELL := /bin/bash
 VENV := .venv
 PY := $(VENV)/bin/python
