@@ -148,6 +148,18 @@ def test_nothing_to_redo(study):
     assert pending_jobs(study[1]) == {}
 
 
+def test_the_settings_of_the_last_run_have_a_stable_path(study, tmp_path):
+    """{results}/config/effective.yaml points at the content-named config the run's jobs read; a dry run with
+    other settings writes its own content-named file and leaves the link (and the running jobs' file) alone."""
+    results, config = study
+    link = results / "config" / "effective.yaml"
+    assert link.is_symlink() and re.fullmatch(r"effective-[0-9a-f]{12}\.yaml", os.readlink(link)), os.readlink(link)
+    pointed = link.resolve()
+    assert load_config(link)["design"]["n_runs"] == 40 and load_config(link)["study"]["results_dir"] == str(results)
+    assert pending_jobs(config, overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
+    assert link.resolve() == pointed and len(list(link.parent.glob("effective-*.yaml"))) >= 2
+
+
 def test_sampler_setting_reruns_no_simulation(study, tmp_path):
     jobs = pending_jobs(study[1], overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
     assert jobs.get("calibrate") == 4
