@@ -35,7 +35,7 @@ def test_the_example_deck_is_valid_and_builtin_is_the_default(paper_config):
     ({"templates": ["no/such/deck.txt"]}, r"simulator\.command\.templates\[0\]: no/such/deck\.txt does not exist"),
     ({"command": "{python} run.py --velocity {velocity}"},
      r"simulator\.command\.command: line 1: unknown placeholder \{velocity\}; known: run \(id\)"),
-    ({"timeout_s": 0}, r"simulator\.command\.timeout_s: 0 is less than or equal to the minimum of 0"),
+    ({"timeout_s": 0}, r"simulator\.command\.timeout_s: 0 is not a positive number"),
     ({"output": {"kind": "trace", "file": "trace.csv", "time_column": "t_us"}},
      r"simulator\.command\.output\.velocity_column: missing; a trace output names its velocity column"),
     ({"retries": -1}, r"simulator\.command\.retries: -1 is less than the minimum of 0"),
