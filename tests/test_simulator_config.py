@@ -106,3 +106,16 @@ def test_the_cli_refuses_a_bad_simulator_in_one_line_before_running(paper_config
     err = capsys.readouterr().err.strip()
     assert code == 2 and err.count("\n") == 0 and "simulator.command.timeout_s" in err
     assert not (tmp_path / "runs").exists()
+
+
+def test_the_library_refuses_what_the_config_refuses():
+    from shockcal.errors import InputError
+    from shockcal.simulators.command import CommandSettings
+    from shockcal.simulators.outputs import OutputSpec
+
+    with pytest.raises(InputError, match=r"OutputSpec\.velocity_column: missing; a trace output names its velocity"):
+        OutputSpec("trace", "trace.csv", velocity_column="")
+    with pytest.raises(InputError, match=r"OutputSpec\.velocity_unit: 'm/us' is not one of"):
+        OutputSpec("trace", "trace.csv", velocity_unit="m/us")
+    with pytest.raises(InputError, match=r"CommandSettings\.timeout_s: 0 is not a positive number"):
+        CommandSettings(("deck.txt",), "run", OutputSpec("features", "features.csv"), timeout_s=0)

@@ -37,6 +37,7 @@ import pandas as pd
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
+from shockcal.hydro.rules import check_fields
 from shockcal.io import atomic_path
 from shockcal.progress import progress
 from shockcal.simulators.builtin import DIAGNOSTICS, simulation_columns
@@ -69,6 +70,11 @@ class CommandSettings:
     timeout_s: float
     retries: int = 0
     env: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self):
+        check_fields(self, {"timeout_s": "positive", "retries": "nonnegative"})
+        if not self.templates:
+            raise InputError("CommandSettings.templates: no template files; give at least one")
 
 
 def simulate_design_command(design: pd.DataFrame, mapping: ShotMapping, geometry: Geometry,

@@ -8,12 +8,14 @@ units its spec declares and converted to us and m/s; a features row is in us and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from shockcal.errors import InputError
 from shockcal.io import text_encoding
 from shockcal.plausibility import OTHER_UNITS, PLATEAU_RATIO, feature_problems
 from shockcal.units import VELOCITY_TO_M_S
@@ -44,6 +46,27 @@ class OutputSpec:
     time_unit: str = "us"
     velocity_column: str = "v_m_s"
     velocity_unit: str = "m/s"
+
+    def __post_init__(self):
+        found = output_problem(asdict(self))
+        if found:
+            raise InputError(f"OutputSpec.{found[0]}: {found[1]}")
+
+
+def output_problem(spec: Mapping) -> tuple[str, str] | None:
+    """(key, what is wrong) with an output spec's fields, or None: its kind and units known, a trace's
+    columns named. The config's `simulator.command.output` is checked with the same words."""
+    kind = spec.get("kind", "trace")
+    if kind not in ("trace", "features"):
+        return "kind", f"{kind!r} is not trace or features"
+    for key, known in (("time_unit", TIME_TO_US), ("velocity_unit", VELOCITY_TO_M_S)):
+        if spec.get(key) is not None and spec[key] not in known:
+            return key, f"{spec[key]!r} is not one of {list(known)}"
+    for column, unit, default in (("time_column", "time_unit", "us"), ("velocity_column", "velocity_unit", "m/s")):
+        if kind == "trace" and not spec.get(column):
+            return column, (f"missing; a trace output names its {column.split('_')[0]} column (and its unit, {unit}: "
+                            f"default {default})")
+    return None
 
 
 def read_output(path: Path, spec: OutputSpec, window_end_us: float, impact_velocity_m_s: float) -> dict:

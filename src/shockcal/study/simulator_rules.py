@@ -45,14 +45,12 @@ def check_command(config: dict, source: str) -> None:
 
 
 def check_output(output: dict, where: str) -> None:
-    """A trace output declares its time and velocity columns."""
-    if output.get("kind", "trace") != "trace":
-        return
-    for column in ("time_column", "velocity_column"):
-        if not output.get(column):
-            unit = column.replace("column", "unit")
-            raise ConfigError(f"{where}.{column}: missing; a trace output names its {column.split('_')[0]} column "
-                              f"(and its unit, {unit}: default {'us' if column == 'time_column' else 'm/s'})")
+    """The output spec's rules (`shockcal.simulators.outputs.output_problem`, the library's own)."""
+    from shockcal.simulators.outputs import output_problem
+
+    found = output_problem(output)
+    if found:
+        raise ConfigError(f"{where}.{found[0]}: {found[1]}")
 
 
 def check_archive(config: dict, source: str) -> None:
