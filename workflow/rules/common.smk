@@ -9,6 +9,7 @@ from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
 from shockcal.study.next_shot_check import plan_check
+from shockcal.study.config import wave_sizes
 from shockcal.study.stages import figure_config, stage_config
 from shockcal.study.workflow import (
     chunk_count,
@@ -68,6 +69,11 @@ def run_set_settings(stage):
     """The rule param of `stage`'s config slice for the job's shot, or its candidate's stage for a next-shot
     candidate (the run sets next_shot, next_shot_check and next_shot_truth)."""
     return lambda w: stage_config(config, stage if w.shot in SHOTS else CANDIDATE_STAGES[stage], w.shot)
+
+
+def allow_empty(wildcards):
+    """`--allow-empty` for a sequential study's later wave (a stopped wave has no runs), else nothing."""
+    return "--allow-empty" if wildcards.run_set in WAVES else ""
 
 
 def simulations(run_set, shot):

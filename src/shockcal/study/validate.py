@@ -158,6 +158,7 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for shot in config["design"]["base_shots"] or []:
         if shot not in config["shots"]:
             raise ConfigError(f"{source}: design.base_shots: '{shot}' is not a shot; known shots are {sorted(config['shots'])}")
+    check_waves(config, source)
     design_file = config["design"].get("file")
     if design_file and not Path(design_file).is_file():
         raise ConfigError(f"{source}: design.file: {design_file} does not exist")
@@ -186,6 +187,20 @@ def check_semantics(config: dict, source: str = "config") -> None:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
                               f"{'published' if source_section == 'records' else 'records'}")
+
+
+def check_waves(config: dict, source: str = "config") -> None:
+    """A sequential study's budget holds wave 0 (`design.waves.max_runs` >= `initial_runs`), and its
+    wave 0 is a Latin hypercube (no `design.file`)."""
+    if config["design"]["strategy"] != "waves":
+        return
+    waves = config["design"]["waves"]
+    if waves["max_runs"] < waves["initial_runs"]:
+        raise ConfigError(f"{source}: design.waves.max_runs: {waves['max_runs']} is below wave 0's "
+                          f"design.waves.initial_runs ({waves['initial_runs']}); the budget must hold wave 0")
+    if config["design"]["file"]:
+        raise ConfigError(f"{source}: design.file: a design file and design.strategy: waves do not go together "
+                          "(wave 0 is a Latin hypercube); set one of them")
 
 
 def _law_has_modulus(config: dict) -> bool:
