@@ -37,8 +37,15 @@ from shockcal.inference.calibration import calibrate
 from shockcal.inference.predict import draw_posterior_design
 from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
 from shockcal.seeds import stream_seed
-from shockcal.study.adapters import (calibration_settings, emulator_spec, extractor_settings, hydro_inputs,
-                                     observed_table, shot_mapping, study_design)
+from shockcal.study.adapters import (
+    calibration_settings,
+    emulator_spec,
+    extractor_settings,
+    hydro_inputs,
+    observed_table,
+    shot_mapping,
+    study_design,
+)
 from shockcal.study.config import prior_bounds, shot_config
 from shockcal.study.validate import load_config
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
@@ -93,8 +100,8 @@ def kfold_rmse(emulator) -> float:
     return float(np.sqrt(np.mean((cv["predicted"] - cv["simulated"]) ** 2)))
 
 
-def posterior_move(draws: pd.DataFrame, reference: pd.DataFrame, bounds) -> tuple[float, str]:
-    """The largest |q - q_ref| over the inputs and the 5/50/95% points, in fractions of the box."""
+def posterior_move(draws: pd.DataFrame, reference: pd.DataFrame, bounds) -> str:
+    """The largest |q - q_ref| over the inputs and the 5/50/95% points, in fractions of the box, and where."""
     worst, where = 0.0, ""
     for name, (low, high) in bounds.items():
         ones = np.ones(len(draws)) / len(draws)
@@ -104,7 +111,7 @@ def posterior_move(draws: pd.DataFrame, reference: pd.DataFrame, bounds) -> tupl
         moves = np.abs(q - q_ref) / (high - low)
         if moves.max() > worst:
             worst, where = float(moves.max()), f"{name} q{round(100 * SUMMARY_QUANTILES[int(np.argmax(moves))]):02d}"
-    return worst, where
+    return f"{worst:.3f} {where}"
 
 
 def main() -> None:
@@ -147,7 +154,7 @@ def main() -> None:
         print(f"{'arm':>13}{'runs/shot':>10}{'held-out RMSE':>14}{'in 90%':>8}{'10-fold RMSE':>13}{'fit s':>7}"
               f"{'posterior move':>22}")
         print(f"{'wave 0':>13}{args.n0:10d}{rmse0:14.2f}{cover0:8.3f}{kfold_rmse(emulator0):13.2f}{'':>7}"
-              f"{'%.3f %s' % posterior_move(posterior0, reference, bounds):>22}", flush=True)
+              f"{posterior_move(posterior0, reference, bounds):>22}", flush=True)
         for name, added in arms.items():
             features = run_features(added, shots, pool)
             design = pd.concat([wave0, added], ignore_index=True)
@@ -158,7 +165,7 @@ def main() -> None:
             rmse, cover = heldout_scores(emulator, heldout, held_features, shots)
             move = ""
             if args.posteriors:
-                move = "%.3f %s" % posterior_move(calibrate(emulator, shots, observed, settings).draws, reference, bounds)
+                move = posterior_move(calibrate(emulator, shots, observed, settings).draws, reference, bounds)
             print(f"{name:>13}{len(design):10d}{rmse:14.2f}{cover:8.3f}{kfold_rmse(emulator):13.2f}{fit_s:7.1f}"
                   f"{move:>22}  ({load()})", flush=True)
     print(f"total {time.perf_counter() - started:.0f} s")

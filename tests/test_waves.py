@@ -133,3 +133,22 @@ def test_wave_design_command_refuses_the_paper_design_in_one_line(tmp_path):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1
     assert done.stderr.strip().endswith("error: wave-design: design.strategy is 'lhs'; waves need 'waves'")
+
+
+def test_a_stopped_wave_passes_through_simulate_and_features_with_no_runs(paper_config):
+    from shockcal.simulators.builtin import simulate_design
+    from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
+    from shockcal.velocimetry.features import check_failures, features_table
+
+    bounds = prior_bounds(paper_config)
+    empty = pd.DataFrame({"run": np.array([], dtype=np.int64), **{k: np.array([]) for k in bounds}})
+    traces = simulate_design(empty, shot_mapping(paper_config, "104S"),
+                             *hydro_inputs(paper_config, paper_config["shots"]["104S"]))
+    assert traces.empty and {"run", "status", "reason", "t_us", "v_m_s"} <= set(traces.columns)
+    with pytest.raises(InputError, match="no runs"):
+        features_table(traces, extractor_settings(paper_config, "104S"), "chunk")
+    features = features_table(traces, extractor_settings(paper_config, "104S"), "chunk", allow_empty=True)
+    assert features.empty and "v_plastic" in features.columns
+    check_failures(features, 0.05, "104S", allow_empty=True)
+    with pytest.raises(InputError, match="no runs"):
+        check_failures(features, 0.05, "104S")

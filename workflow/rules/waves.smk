@@ -117,7 +117,11 @@ rule wave_calibrate:
 
 def wave_design_inputs(wildcards):
     """Wave k's design reads step k-1's posterior, runs and (max_variance) emulator, wave k-1's design
-    (empty: the study stopped) and step k-2's posterior summary (the stopping rule)."""
+    (empty: the study stopped) and step k-2's posterior summary (the stopping rule). All `ancient`: a
+    wave's design, once made, stays (its runs are valid training runs wherever they lie), so a change
+    upstream (the extractor, the emulator or sampler settings) refits and recalibrates on the same runs
+    and reruns no hydrocode; a change of design.waves (params) redesigns. To redesign after another
+    change, delete the waves' designs."""
     k = int(wildcards.wave)
     inputs = {
         "posterior": rules.wave_calibrate.output.samples.format(step=k - 1),
@@ -129,7 +133,7 @@ def wave_design_inputs(wildcards):
     }
     if k >= 2:
         inputs["earlier"] = rules.wave_calibrate.output.summary.format(step=k - 2)
-    return inputs
+    return {name: ancient(path) for name, path in inputs.items()}
 
 
 rule wave_design:

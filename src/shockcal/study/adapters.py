@@ -16,8 +16,7 @@ from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_h
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
 from shockcal.seeds import stream_seed
-from shockcal.study.config import (candidate_config, end_time_us, prior_bounds, shot_config, velocity_box_m_s,
-                                   wave_sizes)
+from shockcal.study.config import candidate_config, end_time_us, prior_bounds, shot_config, velocity_box_m_s, wave_sizes
 from shockcal.study.strength import DEFAULT_MODEL, strength_model
 
 if TYPE_CHECKING:
