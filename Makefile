@@ -10,7 +10,7 @@ LOCKED_PYTHON := 3.11
 CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: study sequential quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 $(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -23,6 +23,9 @@ study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and
 	snakemake --report results/report.html all
 	shockcal stage-times --benchmarks results/benchmarks
 	@echo "report: $(CURDIR)/results/report.html"
+
+sequential: $(INSTALLED)  ## the study in waves placed from the joint posterior (config/sequential.yaml; docs/sequential.md) into results/sequential
+	snakemake --cores $(CORES) all --configfile config/sequential.yaml
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
 	snakemake --cores $(CORES) all --configfile config/quick.yaml
