@@ -121,6 +121,8 @@ def main() -> None:
     parser.add_argument("--heldout", type=int, default=30, help="held-out runs per shot from the reference posterior")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--posteriors", action="store_true", help="also calibrate each arm (reduced sampler)")
+    parser.add_argument("--arms", nargs="+", default=["lhs", "thinned", "widened", "max_variance"],
+                        help="the arms to run (default: all four)")
     args = parser.parse_args()
     config = study_config()
     shots, bounds = list(config["shots"]), prior_bounds(config)
@@ -155,7 +157,7 @@ def main() -> None:
               f"{'posterior move':>22}")
         print(f"{'wave 0':>13}{args.n0:10d}{rmse0:14.2f}{cover0:8.3f}{kfold_rmse(emulator0):13.2f}{'':>7}"
               f"{posterior_move(posterior0, reference, bounds):>22}", flush=True)
-        for name, added in arms.items():
+        for name, added in [(name, arms[name]) for name in args.arms]:
             features = run_features(added, shots, pool)
             design = pd.concat([wave0, added], ignore_index=True)
             fit_start = time.perf_counter()

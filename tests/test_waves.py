@@ -152,3 +152,15 @@ def test_a_stopped_wave_passes_through_simulate_and_features_with_no_runs(paper_
     check_failures(features, 0.05, "104S", allow_empty=True)
     with pytest.raises(InputError, match="no runs"):
         check_failures(features, 0.05, "104S")
+
+
+def test_features_of_a_wave_with_runs_keep_their_values(paper_config):
+    from shockcal.simulators.builtin import simulate_design
+    from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping, study_design
+    from shockcal.velocimetry.features import features_table
+
+    design, _ = study_design(paper_config, n_runs=2)
+    traces = simulate_design(design, shot_mapping(paper_config, "104S"),
+                             *hydro_inputs(paper_config, paper_config["shots"]["104S"]))
+    features = features_table(traces, extractor_settings(paper_config, "104S"), "chunk", allow_empty=True)
+    assert features["v_plastic"].between(150, 260).all()

@@ -393,7 +393,7 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
             except FeatureError as exc:
                 row.update(status="failed", reason=f"feature extraction: {exc}")
         rows.append(row)
-    table = pd.DataFrame(rows, columns=["run", "status", "reason"])
+    table = pd.DataFrame(rows) if rows else pd.DataFrame(columns=["run", "status", "reason"])
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
