@@ -96,3 +96,49 @@ def check_model_shots(model):
 def check_model_settings(stage):
     """The rule param of `stage`'s config slice in the model's study."""
     return lambda w: stage_config(CHECK_PLANS[w.model]["study"] if w.model in CHECK_PLANS else config, stage)
+
+
+# A sequential study's waves (waves.smk): wave 0 is the training run set, step k every run of waves 0..k.
+def step_path(step, *parts):
+    """A step's file or directory: {RESULTS}/waves/step{step}/{parts...}."""
+    return run_set_path("waves", f"step{step}", *parts)
+
+
+def wave_design_path(wave):
+    """Wave `wave`'s design: the training design for wave 0."""
+    return DESIGN if int(wave) == 0 else run_set_path(f"wave{wave}", "design.parquet")
+
+
+def step_features(step):
+    """The features of every shot of waves 0..`step`, wave after wave."""
+    return [
+        rules.features.output[0].format(run_set=run_set, shot=shot)
+        for run_set in WAVE_RUN_SETS[: int(step) + 1]
+        for shot in SHOTS
+    ]
+
+
+def pairs(shots, paths):
+    """SHOT=FILE arguments of the `shockcal` commands, shot after shot."""
+    return " ".join(f"{shot}={path}" for shot, path in zip(shots, paths))
+
+
+def wave_design_inputs(wildcards):
+    """Wave k's design reads step k-1's posterior, runs and (max_variance) emulator, wave k-1's design
+    (empty: the study stopped) and step k-2's posterior summary (the stopping rule). All `ancient`: a
+    wave's design, once made, stays (its runs are valid training runs wherever they lie), so a change
+    upstream (the extractor, the emulator or sampler settings) refits and recalibrates on the same runs
+    and reruns no hydrocode; a change of design.waves (params) redesigns. To redesign after another
+    change, delete the waves' designs."""
+    k = int(wildcards.wave)
+    inputs = {
+        "posterior": rules.wave_calibrate.output.samples.format(step=k - 1),
+        "summary": rules.wave_calibrate.output.summary.format(step=k - 1),
+        "previous": wave_design_path(k - 1),
+        "runs": rules.merge_runs.output.design.format(step=k - 1),
+        "emulator": rules.wave_emulator.output.emulator.format(step=k - 1),
+        "observed": rules.observed.output[0],
+    }
+    if k >= 2:
+        inputs["earlier"] = rules.wave_calibrate.output.summary.format(step=k - 2)
+    return {name: ancient(path) for name, path in inputs.items()}
