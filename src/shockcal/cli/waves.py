@@ -125,7 +125,8 @@ def run_merge(args) -> int:
     write_table(design, out / "design.parquet", {"table": "design", "source": f"merged from {' '.join(args.designs)}",
                                                  "units": {k: config["inputs"][k]["unit"] for k in config["inputs"]}})
     for shot, paths in by_shot.items():
-        table = read_tables([p for p in paths if not read_table(p).empty] or paths[:1], ["run"], "features")
+        with_runs = [path for path in paths if not read_table(path).empty]     # a stopped wave's table has none
+        table = read_tables(with_runs or paths[:1], ["run"], "features")
         write_table(table, out / "features" / f"{shot}.parquet", {"table": "features", "shot": shot,
                                                                   "merged": paths})
     logging.getLogger("shockcal.design.waves").info("%d runs of %d designs -> %s", len(design), len(designs), out)
