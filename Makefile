@@ -1,4 +1,4 @@
-# shockcal: `make study` runs the paper's study, `make test` the tests. Both create .venv first.
+# shockcal: `make help` lists the targets (also what a bare `make` does); `make env` creates .venv and installs, as every target that runs shockcal does first.
 SHELL := /bin/bash
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -10,7 +10,29 @@ LOCKED_PYTHON := 3.11
 CONSTRAINTS = $$($(PY) -c 'import sys; v = "%d.%d" % sys.version_info[:2]; ok = v == "$(LOCKED_PYTHON)"; ok or print(f"warning: Python {v}: constraints.txt is for $(LOCKED_PYTHON); installing from pyproject.toml ranges", file=sys.stderr); print("-c constraints.txt" if ok else "")')
 export PATH := $(CURDIR)/$(VENV)/bin:$(PATH)
 
-.PHONY: study sequential quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+# snakemake's console: one progress line (jobs done and left, the time left) and any error in full, every line
+# it would print in RESULTS_DIR/logs/snakemake/<start time>.log (the logger plugin shockcal, docs/workflow.md):
+# $(call snakemake,RESULTS_DIR). VERBOSE=1 (`make quick VERBOSE=1`) prints snakemake's own output instead.
+VERBOSE ?=
+snakemake = snakemake$(if $(filter-out 0,$(VERBOSE)),, --logger shockcal --logger-shockcal-log-dir $(1)/logs/snakemake)
+
+# $(call study,RESULTS_DIR,SNAKEMAKE_ARGS): a whole study, its HTML report and its time per stage
+# (RESULTS_DIR/stage_times.txt), then where they are
+define study
+	$(call snakemake,$(1)) --cores $(CORES) $(2)
+	$(call snakemake,$(1)) --report $(1)/report.html $(2)
+	shockcal stage-times --benchmarks $(1)/benchmarks > $(1)/stage_times.txt
+	@echo "results: $(CURDIR)/$(1)/ (time per stage: stage_times.txt; settings: config/effective.yaml)"
+	@echo "report:  $(CURDIR)/$(1)/report.html"
+endef
+
+.DEFAULT_GOAL := help
+.PHONY: help env study sequential quick models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+
+help:  ## these targets, one line each
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
+
+env: $(INSTALLED)  ## the environment only: creates .venv and installs shockcal with its test tools, nothing else
 
 $(INSTALLED): pyproject.toml constraints.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -18,17 +40,14 @@ $(INSTALLED): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test]'
 	touch $@
 
-study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report
-	snakemake --cores $(CORES) all
-	snakemake --report results/report.html all
-	shockcal stage-times --benchmarks results/benchmarks
-	@echo "report: $(CURDIR)/results/report.html"
+study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report into results
+	$(call study,results,all)
 
 sequential: $(INSTALLED)  ## the study in waves placed from the joint posterior (config/sequential.yaml; docs/sequential.md) into results/sequential
-	snakemake --cores $(CORES) all --configfile config/sequential.yaml
+	$(call study,results/sequential,all --configfile config/sequential.yaml)
 
-quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) into results/quick
-	snakemake --cores $(CORES) all --configfile config/quick.yaml
+quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) and its HTML report into results/quick
+	$(call study,results/quick,all --configfile config/quick.yaml)
 
 # the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
 # posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files
@@ -39,13 +58,15 @@ MODELS_DIR ?= results/models
 
 models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
 	for model in $(MODELS); do \
-	  snakemake --cores $(CORES) --configfile $(MODELS_CONFIG) --config "strength={model: $$model}" \
+	  $(call snakemake,$(MODELS_DIR)/$$model) --cores $(CORES) --configfile $(MODELS_CONFIG) --config "strength={model: $$model}" \
 	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.nc || exit 1; \
 	done
 	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
 	  --figures-dir $(MODELS_DIR)/figures
 	shockcal model-predictions --config $(firstword $(MODELS_CONFIG)) $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) \
 	  --out $(MODELS_DIR)/release.csv --figures-dir $(MODELS_DIR)/figures
+	@echo "results: $(CURDIR)/$(MODELS_DIR)/ (one study per law: $(MODELS))"
+	@echo "tables:  $(CURDIR)/$(MODELS_DIR)/evidence.csv and release.csv; figures: $(CURDIR)/$(MODELS_DIR)/figures/"
 
 models-reduced: $(INSTALLED)  ## the same at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
@@ -54,15 +75,18 @@ models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into res
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/quick.yaml" MODELS_DIR=results/models-quick
 
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
-	snakemake --cores $(CORES) check
+	$(call snakemake,results) --cores $(CORES) check
+	@echo "results: $(CURDIR)/results/posterior/coverage_emulator.parquet and coverage_hydrocode.parquet"
+	@echo "report:  their table joins $(CURDIR)/results/report.html at the next make study"
 
 next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain
-	snakemake --cores $(CORES) next_shot
-	@echo "ranking: $(CURDIR)/results/next_shot/ranking.csv"
+	$(call snakemake,results) --cores $(CORES) next_shot
+	@echo "results: $(CURDIR)/results/next_shot/ranking.csv"
+	@echo "figure:  $(CURDIR)/results/figures/next_shot.png"
 
 next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: its best and worst candidates on truths from the posterior
-	snakemake --cores $(CORES) next_shot_check
-	@echo "check: $(CURDIR)/results/next_shot/check_summary.csv"
+	$(call snakemake,results) --cores $(CORES) next_shot_check
+	@echo "results: $(CURDIR)/results/next_shot/check_summary.csv (per trial: check.csv)"
 
 test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 	$(VENV)/bin/pytest
@@ -76,9 +100,11 @@ test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (r
 bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); installs the reference samplers
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,bench]'
 	$(PY) benchmarks/run_all.py
+	@echo "results: printed above (never written); the cached reference runs: $(CURDIR)/benchmarks/out/reference/"
 
 validate: $(INSTALLED)  ## our hydrocode + extractor against the paper's FLAG features and measured features
 	$(PY) benchmarks/validate_flag.py
+	@echo "results: printed above; our features: $(CURDIR)/benchmarks/out/validate_flag_features.parquet"
 
 lint: $(INSTALLED)  ## ruff on the package, tests and benchmarks; snakefmt and snakemake's own lint on the rules
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,lint]'
@@ -92,5 +118,5 @@ lock:  ## refresh constraints.txt: the newest releases pyproject.toml allows, re
 	{ sed -n '/^#/p' constraints.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v -i '^shockcal'; } > constraints.new
 	mv constraints.new constraints.txt && rm -rf .lock-venv
 
-clean:
+clean:  ## removes results/ and .snakemake/ (the .venv stays)
 	rm -rf results .snakemake

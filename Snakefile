@@ -5,17 +5,24 @@ import re
 
 from shockcal.study.validate import validate_or_exit
 
+CONFIGFILE = "config/config.yaml"
 
-configfile: "config/config.yaml"
+
+configfile: CONFIGFILE
 
 
 report: "workflow/report/workflow.rst"
 
 
-# jsonschema against workflow/schemas/config.schema.yaml (the package's schema; defaults filled in), then
+# jsonschema against the package's schema (src/shockcal/config.schema.yaml; defaults filled in), then
 # the cross-field rules and the design file's contents; a bad config ends snakemake with its message
-# alone, naming the key path: "shockcal: error: config: simulate.chunk_size: 0 is less than ..."
-validate_or_exit(config, source="config")
+# alone, naming the file that sets the key and the key path:
+# "shockcal: error: config/quick.yaml: simulate.chunk_size: 0 is less than the minimum of 1"
+validate_or_exit(
+    config,
+    files=[CONFIGFILE, *map(str, workflow.overwrite_configfiles)],
+    overrides=workflow.config_settings.config,
+)
 
 RESULTS = config["study"]["results_dir"]
 SHOTS = list(config["shots"])

@@ -1,11 +1,14 @@
-"""Shared fixtures: the study config and the paper's reference data (skipped when absent)."""
+"""Shared fixtures: the study config, the paper's reference data (skipped when absent) and one quick study."""
 
 from __future__ import annotations
 
 import copy
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from shockcal.reference import reference_dir
 from shockcal.study.validate import load_config
@@ -31,3 +34,19 @@ def reference_data() -> Path:
     if path is None:
         pytest.skip("reference data (../shared/data/al5083) not found; set SHOCKCAL_REFERENCE_DATA to run this test")
     return path
+
+
+@pytest.fixture(scope="session")
+def quick_study(tmp_path_factory) -> tuple[Path, Path]:
+    """The quick study (config/quick.yaml, about two minutes on 2 idle cores) run once per session, end to
+    end, into a temporary results directory: (that directory, the config overlay naming it). Tests that
+    need a finished study read it; none may change it for good."""
+    root = tmp_path_factory.mktemp("quick")
+    results, overlay = root / "results", root / "results.yaml"
+    overlay.write_text(yaml.safe_dump({"study": {"results_dir": str(results)}}))
+    snakemake = str(Path(sys.executable).parent / "snakemake")
+    done = subprocess.run([snakemake, "all", "--cores", "2", "--configfile", "config/quick.yaml", str(overlay)],
+                          cwd=REPO, capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.fail(f"the quick study failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
+    return results, overlay

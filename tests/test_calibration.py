@@ -135,9 +135,16 @@ def test_calibrate_returns_draws_summary_and_evidence(paper_config):
     posterior = calibrate(emulator, ["S"], _observed([118.0, 87.2]), settings)
     samples, summary, info = posterior.draws, posterior.summary(), posterior.info()
     assert len(samples) == 1000 and set(samples.columns) == {"A", "lambda_y", "log_likelihood"}
-    assert list(summary["parameter"]) == ["A", "lambda_y"] and list(summary["unit"]) == ["Mbar", "-"]
-    row = summary.set_index("parameter").loc["A"]
+    assert list(summary["parameter"]) == ["A_MPa", "lambda_y"] and list(summary["unit"]) == ["MPa", "-"]
+    row = summary.set_index("parameter").loc["A_MPa"]
     assert row["q05"] < row["q50"] < row["q95"] and row["ess"] >= 800 and info["ess_kish"] == row["ess"]
+    native = posterior.summary(native=True)                   # as sampled: Mbar, the draws' unit
+    assert list(native["parameter"]) == ["A", "lambda_y"] and list(native["unit"]) == ["Mbar", "-"]
+    scaled = [c for c in native.columns if c not in ("parameter", "unit", "ess")]
+    np.testing.assert_allclose(summary.loc[0, scaled].to_numpy(float), 1e5 * native.loc[0, scaled].to_numpy(float),
+                               rtol=1e-12)
+    np.testing.assert_array_equal(summary.loc[1, scaled].to_numpy(float), native.loc[1, scaled].to_numpy(float))
+    assert info["user_units"] == {"A": "MPa", "lambda_y": "-"}
     assert info["parameters"] == ["A"] and np.isfinite(info["log_evidence"]) and info["likelihood_evaluations"] > 800
 
 

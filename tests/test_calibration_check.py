@@ -337,9 +337,13 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
             "--observed", str(tmp_path / "obs.csv"), "--out", str(out)]
     assert main(args) == 0
     meta = read_table_metadata(out)
-    assert meta["units"]["V1"] == "cm/us" and meta["shots"] == ["104S"]
-    summary = pd.read_parquet(tmp_path / "post" / "104S_summary.parquet")
-    assert summary["parameter"].tolist() == [*emu.required_inputs(["104S"]), "lambda_y"]
+    assert meta["units"]["V1"] == "cm/us" and meta["user_units"]["V1"] == "m/s" and meta["shots"] == ["104S"]
+    assert meta["user_units"]["G1"] == "GPa" and meta["user_units"]["A"] == "MPa"
+    summary = pd.read_parquet(tmp_path / "post" / "104S_summary.parquet").set_index("parameter")
+    user_names = {"A": "A_MPa", "B": "B_MPa", "V1": "V1_m_s", "G1": "G1_GPa"}
+    assert summary.index.tolist() == [*(user_names.get(k, k) for k in emu.required_inputs(["104S"])), "lambda_y"]
+    box = small_config["inputs"]["V1"]                      # the velocity's quantiles in m/s, inside its box
+    assert 1e4 * box["min"] <= summary.loc["V1_m_s", "q05"] <= summary.loc["V1_m_s", "q95"] <= 1e4 * box["max"]
 
     monkeypatch.undo()
     old = tmp_path / "old_emulator"

@@ -33,10 +33,10 @@ def test_paper_config_is_valid(paper_config):
     "path, value, message",
     [
         ("hydro.cell_size_um", "four", r"hydro\.cell_size_um: 'four' is not of type 'number'"),
-        ("shots.104S.target_mm", -2.0, r"shots\.104S\.target_mm: -2\.0 is less than or equal to the minimum"),
+        ("shots.104S.target_mm", -2.0, r"shots\.104S\.target_mm: -2 is not a positive number"),
         ("simulate.chunk_size", 0, r"simulate\.chunk_size: 0 is less than the minimum of 1"),
         ("inputs.A.min", 0.02, r"inputs\.A: min \(0\.02\) must be below max"),
-        ("inputs.B.min", -0.001, r"inputs\.B\.min: Johnson-Cook parameters cannot be negative"),
+        ("inputs.B.min", -0.001, r"inputs\.B\.min: -0\.001 is negative; Johnson-Cook parameters cannot be negative"),
         ("shots.105S.velocity_input", "V9", r"shots\.105S\.velocity_input: 'V9' is not one of the inputs"),
         ("observed.records", {"104S": {"path": "no/such/record.txt"}},
          r"observed\.records\.104S\.path: no/such/record\.txt does not exist"),
@@ -131,3 +131,47 @@ def test_extractor_settings_defaults_are_the_schemas():
     sections = [schema["features"], schema["shots"]["additionalProperties"]["properties"]["analysis"]]
     defaults = {k: v["default"] for section in sections for k, v in section["properties"].items()}
     assert asdict(ExtractorSettings()) == defaults
+
+
+@pytest.mark.parametrize("path, value, message", [
+    ("next_shot.candidates", [{"shot": "104S", "flyer_mm": 3.95, "target_mm": 5.965, "velocity_m_s": 204}],
+     "next_shot.candidates: a list given, but it must be a mapping (key: value) or null"),
+    ("shots", [{"flyer_mm": 3.95, "target_mm": 5.965}], "shots: a list given, but it must be a mapping (key: value)"),
+    ("observed", "records", "observed: 'records' is not of type 'object'"),
+])
+def test_a_config_of_the_wrong_shape_gets_the_schemas_line(paper_config, path, value, message):
+    """The schema speaks before any code that assumes the config's shape (no AttributeError)."""
+    _set(paper_config, path, value)
+    with pytest.raises(ConfigError) as err:
+        validate_config(paper_config, source="config.yaml")
+    assert str(err.value) == f"config.yaml: {message}"
+
+
+@pytest.mark.parametrize("path, typo, message", [
+    ("shots.104S", "traget_mm", "shots.104S: Additional properties are not allowed ('traget_mm' was unexpected); "
+                                "did you mean 'target_mm'?"),
+    ("hydro", "cell_size", "hydro: Additional properties are not allowed ('cell_size' was unexpected); "
+                           "did you mean 'cell_size_um'?"),
+    ("", "shot", "<top level>: Additional properties are not allowed ('shot' was unexpected); did you mean 'shots'?"),
+])
+def test_a_key_typo_gets_did_you_mean(paper_config, path, typo, message):
+    _set(paper_config, f"{path}.{typo}".lstrip("."), 1.0)
+    with pytest.raises(ConfigError) as err:
+        validate_config(paper_config, source="config.yaml")
+    assert str(err.value) == f"config.yaml: {message}"
+
+
+def test_an_error_names_the_file_of_the_merged_config_that_sets_the_key(tmp_path, monkeypatch):
+    """Snakemake merges config/config.yaml, then each --configfile overlay, then --config; the message
+    names the one that set the key at fault (tests/test_faults.py runs snakemake on an overlay)."""
+    from shockcal.study.validate import config_source_of
+
+    monkeypatch.chdir(REPO)
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("simulate:\n  chunk_size: 0\nshots:\n  104S:\n    flyer_mm: 0.001\n")
+    files = ["config/config.yaml", "config/quick.yaml", str(overlay)]
+    assert config_source_of("simulate.chunk_size", files) == str(overlay)
+    assert config_source_of("shots.104S.flyer_mm", files) == str(overlay)
+    assert config_source_of("shots.104S.target_mm", files) == "config/config.yaml"
+    assert config_source_of("hydro.cell_size_um", files) == "config/quick.yaml"
+    assert config_source_of("hydro.cfl", files, {"hydro": {"cfl": 2}}) == "snakemake --config"

@@ -54,7 +54,7 @@ DESIGN_FAULTS = {
                         ["run 3", "impact velocity V1", "in m/s (204 m/s = 0.0204 cm/us)", "checks.design_box"]),
     "modulus-in-GPa": (lambda d: _set(d, 2, "G1", 30.0), ["run 2", "G1", "in GPa (30 GPa = 0.3 Mbar)"]),
     "duplicate-run": (lambda d: d.assign(run=[4, 4, 5, 6, 7]), ["run id 4 appears more than once"]),
-    "nan": (lambda d: _set(d, 2, "A", np.nan), ["run 2: parameter A is not a finite number"]),
+    "nan": (lambda d: _set(d, 2, "A", np.nan), ["run 2: parameter A is not a finite number (nan)"]),   # no np.float64
     "text": (lambda d: d.assign(B=d["B"].astype(object)).pipe(_set, 4, "B", "0.002 Mbar"),
              ["run 4: parameter B is not a finite number ('0.002 Mbar')"]),
     "negative": (lambda d: _set(d, 0, "C", -0.01), ["run 0: parameter C", "negative"]),
@@ -78,7 +78,7 @@ def test_design_unreadable_and_non_positive_velocity(tmp_path, paper_config):
     with pytest.raises(InputError, match=f"table {path} could not be read"):
         load_study_design(path, paper_config)
     design = latin_hypercube(prior_bounds(paper_config), 3, seed=1).assign(V2=0.0)
-    with pytest.raises(InputError, match="d.csv: run 0: impact velocity V2 = 0.0 must be positive for shot 105S"):
+    with pytest.raises(InputError, match="d.csv: run 0: impact velocity V2 = 0 must be positive for shot 105S"):
         shot_mapping(paper_config, "105S").check_positive(design, "d.csv")
 
 
@@ -134,6 +134,10 @@ def _record(tmp, kind):
         _write(path, t, v, header="a,b")
     elif kind == "decimal-comma":
         path.write_text("% t (us)\tUp (m/s)\n" + "".join(f"{a:.4f}\t{b:.3f}\n".replace(".", ",") for a, b in zip(t, v)))
+    elif kind == "cut-before-shock":        # noise about rest (0.3 m/s, as the paper's records), no rise
+        _write(path, t, np.random.default_rng(1).normal(0.0, 0.3, t.size))
+    elif kind == "one-column":
+        path.write_text("v_m_s\n" + "".join(f"{b!r}\n" for b in v))
     elif kind == "empty":
         path.write_text("% only a comment\n")
     elif kind == "missing":
@@ -157,6 +161,9 @@ RECORD_FAULTS = {
     "decimal-comma": ["line 401: '0,1995' has a decimal comma"],
     "empty": ["no data lines"],
     "missing": ["does not exist"],
+    "cut-before-shock": ["no shock in it: up to its end at 0.1995 us its velocity stays below 10 m/s",
+                         "the record ends before the shock arrives"],
+    "one-column": ["one column ('v_m_s'); a record needs two, time (us) and velocity (m/s)"],
 }
 
 
@@ -169,6 +176,7 @@ def test_record_faults(tmp_path, fault):
     assert message.startswith(f"record {path}") and "\n" not in message
     for fragment in RECORD_FAULTS[fault]:
         assert fragment in message
+    assert fault == "km/s" or "km/s" not in message                  # no unit slip suggested for a cut record
 
 
 def test_record_named_column_that_is_absent(tmp_path):
@@ -284,10 +292,11 @@ def test_config_file_faults(tmp_path):
 
 
 @pytest.mark.parametrize("overlay, fragment", [
-    ({"simulate": {"chunk_size": 0}}, "config: simulate.chunk_size: 0 is less than the minimum of 1"),
-    ("design-in-m/s", "config: design.file: {tmp}/design.csv: run 3: impact velocity V1 of shot 104S = 204 cm/us"),
+    ({"simulate": {"chunk_size": 0}}, "{tmp}/overlay.yaml: simulate.chunk_size: 0 is less than the minimum of 1"),
+    ("design-in-m/s", "{tmp}/overlay.yaml: design.file: {tmp}/design.csv: run 3: impact velocity V1 of shot 104S = 204 cm/us"),
 ])
 def test_snakemake_prints_the_config_error_alone(tmp_path, paper_config, overlay, fragment):
+    """One line, naming the file of the merged config (base, overlay or the overlay's overlay) that sets the key."""
     if overlay == "design-in-m/s":
         overlay = {"design": {"file": str(_design(tmp_path, paper_config, DESIGN_FAULTS["velocity-in-m/s"][0]))}}
     (tmp_path / "overlay.yaml").write_text(yaml.safe_dump(overlay))

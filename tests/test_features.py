@@ -258,8 +258,10 @@ def test_record_with_unnamed_columns_asks_for_names(tmp_path):
 
 
 def test_record_without_a_rise_names_the_file(tmp_path, paper_config):
+    """A flat record is stopped as it is read: it ends before the shock (tests/test_faults.py, "cut-before-shock")."""
     path = write_trace(tmp_path / "flat.csv", ["t_us,v_m_s"], [[t, 1.5] for t in T])
-    with pytest.raises(InputError, match=re.escape(f"record {path}: no features for shot {SHOT}: no rise")):
+    with pytest.raises(InputError, match=re.escape(f"record {path}: no shock in it: up to its end at 4 us its velocity "
+                                                   "is 1.5 m/s throughout: the record ends before the shock arrives")):
         record_features(path, extractor_settings(paper_config, SHOT), SHOT)
 
 

@@ -48,21 +48,23 @@ def _run_kernel_strength(monkeypatch, params, strength):
                                       (0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30)])    # m = 0.01
 def test_johnson_cook_general_return_equals_the_floored_one(monkeypatch, table_iv):
     """Johnson-Cook through the general return (its law tuple, the flow stress evaluated every step) gives
-    the floored kernel's trace bit for bit: the floors only skip provably elastic steps."""
+    the floored kernel's trace: the floors only skip provably elastic steps. Two kernels, so compared at the
+    rounding floor (rtol 1e-10 of the peak; bit for bit on the machines measured)."""
     A, B, C, n, m, velocity, G = table_iv
     floored = run_shot(ShotParameters.from_table_iv(*table_iv), THIN)
     law = get_law("johnson-cook").code_type(A, B, C, n, m, AL5083.T_ref_K, AL5083.T_melt_K, AL5083.rate_ref_per_us())
     general = _run_kernel_strength(monkeypatch, ShotParameters.from_table_iv(*table_iv), LawStrength(law, G))
     assert floored.status == general.status == "ok"
-    assert np.array_equal(floored.v_m_s, general.v_m_s)
-    assert floored.n_steps == general.n_steps and floored.max_plastic_strain == general.max_plastic_strain
+    np.testing.assert_allclose(general.v_m_s, floored.v_m_s, rtol=1e-10, atol=1e-10 * np.max(np.abs(floored.v_m_s)))
+    assert floored.n_steps == general.n_steps
+    assert general.max_plastic_strain == pytest.approx(floored.max_plastic_strain, rel=1e-10)
 
 
 def test_steinberg_guinan_without_pressure_temperature_or_hardening_is_constant_yield_johnson_cook():
     """SG with dGdP = dGdT = 0 and beta = 0 is Y = Y0 with a constant G = G0: Johnson-Cook with A = Y0,
     B = 0, C = 0, n = 0 and m = 1000 (T*^1000 underflows to 0, so 1 - T*^m = 1), bit for bit. G0 = 25 GPa
     (0.25 Mbar, a power of two) makes Y0 G / G0 = Y0 exactly. A wrong G, P, T or eta in the wiring of the
-    per-cell modulus, or a unit slip, breaks the equality."""
+    per-cell modulus, or a unit slip, breaks the equality (two kernels: at the rounding floor, rtol 1e-10)."""
     sg = LawShotParameters("sg", {"Y0_GPa": 0.31, "Ymax_GPa": 0.68, "beta": 0.0, "n": 0.1, "G0_GPa": 25.0,
                                   "dGdP": 0.0, "dGdT_over_G0_per_K": 0.0}, V_104S)
     code = sg.law_parameters()
@@ -70,8 +72,8 @@ def test_steinberg_guinan_without_pressure_temperature_or_hardening_is_constant_
     jc = ShotParameters.from_table_iv(code.Y0, 0.0, 0.0, 0.0, 1000.0, sg.velocity_m_s / CM_US_TO_M_S, code.G0)
     a, b = run_shot(sg, THIN), run_shot(jc, THIN)
     assert a.status == b.status == "ok"
-    assert np.array_equal(a.v_m_s, b.v_m_s)
-    assert a.max_plastic_strain == b.max_plastic_strain > 0.0
+    np.testing.assert_allclose(a.v_m_s, b.v_m_s, rtol=1e-10, atol=1e-10 * np.max(np.abs(b.v_m_s)))
+    assert a.max_plastic_strain == pytest.approx(b.max_plastic_strain, rel=1e-10) and b.max_plastic_strain > 0.0
 
 
 @pytest.mark.parametrize("model", list(LAW_RUNS))

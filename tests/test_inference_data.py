@@ -1,9 +1,9 @@
 """Posteriors as ArviZ InferenceData: `shockcal posterior-netcdf` writes a file ArviZ reads back with every
-input, lambda_y, the provenance and the groups; and the README's ArviZ block runs against such a file."""
+input in the units a user reads, lambda_y, the provenance and the groups (the README's ArviZ block runs on
+the quick study: tests/test_study_results.py)."""
 
 from __future__ import annotations
 
-import re
 import subprocess
 from pathlib import Path
 
@@ -23,6 +23,10 @@ az = pytest.importorskip("arviz")
 REPO = Path(__file__).resolve().parents[1]
 CONFIG = str(REPO / "config" / "config.yaml")
 INPUTS_104S = ["A", "B", "C", "n", "m", "V1", "G1"]
+# the inputs in the file: the unit a user reads in the name, and the factor from the config's Table IV unit
+IN_FILE = {"A": ("A_MPa", 1e5), "B": ("B_MPa", 1e5), "C": ("C", 1.0), "n": ("n", 1.0), "m": ("m", 1.0),
+           "V1": ("V1_m_s", 1e4), "G1": ("G1_GPa", 100.0)}
+FILE_NAMES = [IN_FILE[k][0] for k in INPUTS_104S]
 
 
 def write_posterior(tmp_path: Path, config: dict, shots=("104S",), inputs=INPUTS_104S, n=400) -> Path:
@@ -70,14 +74,16 @@ def test_netcdf_reads_back_with_every_input_lambda_y_and_provenance(netcdf):
     draws = pd.read_parquet(posterior)
     assert set(idata.groups()) >= {"posterior", "sample_stats", "observed_data", "constant_data",
                                    "posterior_predictive", "weighted_posterior"}
-    assert list(idata.posterior.data_vars) == [*INPUTS_104S, "lambda_y"]
+    assert list(idata.posterior.data_vars) == [*FILE_NAMES, "lambda_y"]
     rows = idata.posterior["row"].to_numpy()
-    for name in [*INPUTS_104S, "lambda_y"]:
-        assert idata.posterior[name].shape == (1, len(draws))
-        np.testing.assert_array_equal(idata.posterior[name].to_numpy()[0], draws[name].to_numpy()[rows])
+    for name, (file_name, factor) in [*IN_FILE.items(), ("lambda_y", ("lambda_y", 1.0))]:
+        assert idata.posterior[file_name].shape == (1, len(draws))
+        np.testing.assert_allclose(idata.posterior[file_name].to_numpy()[0], draws[name].to_numpy()[rows] * factor,
+                                   rtol=1e-15)
     np.testing.assert_array_equal(idata.sample_stats["log_likelihood"].to_numpy()[0],
                                   draws["log_likelihood"].to_numpy()[rows])
-    assert idata.posterior["A"].attrs["units"] == "Mbar" and idata.posterior["V1"].attrs["units"] == "cm/us"
+    units = {name: idata.posterior[name].attrs["units"] for name in ("A_MPa", "G1_GPa", "V1_m_s", "C", "lambda_y")}
+    assert units == {"A_MPa": "MPa", "G1_GPa": "GPa", "V1_m_s": "m/s", "C": "-", "lambda_y": "-"}
     for attrs in (idata.attrs, idata.posterior.attrs):
         assert attrs["shockcal_version"] == __version__
         assert attrs["log_evidence"] == -45.25 and attrs["log_evidence_sd"] == 0.04
@@ -85,7 +91,9 @@ def test_netcdf_reads_back_with_every_input_lambda_y_and_provenance(netcdf):
         assert attrs["config_digest"] == config_digest(load_stage_config(CONFIG, "calibrate"))
         assert attrs["n_live"] == 200 and attrs["cube_power"] == '{"m": 2.0}'
     box = idata.constant_data
-    assert list(box["input"].to_numpy()) == INPUTS_104S and box["unit"].to_numpy()[0] == "Mbar"
+    assert list(box["input"].to_numpy()) == FILE_NAMES and list(box["unit"].to_numpy()[[0, 5, 6]]) == ["MPa", "m/s", "GPa"]
+    np.testing.assert_allclose(box["prior_lower"].sel(input="A_MPa"), 50.0)         # 0.0005 Mbar
+    np.testing.assert_allclose(box["prior_upper"].sel(input="V1_m_s"), 216.0)       # 0.0216 cm/us
     assert np.all(box["prior_lower"] < box["prior_upper"])
     assert list(idata.observed_data.data_vars) == CALIBRATION_FEATURES
     np.testing.assert_allclose(box["v_elastic_sd"], 0.01 * idata.observed_data["v_elastic"])
@@ -93,11 +101,12 @@ def test_netcdf_reads_back_with_every_input_lambda_y_and_provenance(netcdf):
     np.testing.assert_array_equal(predictive, [100.0, np.nan, 120.0])   # the failed run reads NaN
     weighted = idata["weighted_posterior"]
     assert np.isclose(np.exp(weighted["log_weight"]).sum(), 1.0) and "lambda_y" in weighted
+    assert weighted["G1_GPa"].attrs["units"] == "GPa" and float(weighted["G1_GPa"].min()) >= 20.0   # 0.2 Mbar
 
 
 def test_az_summary_works(netcdf):
     summary = az.summary(az.from_netcdf(netcdf[0]))
-    assert list(summary.index) == [*INPUTS_104S, "lambda_y"]
+    assert list(summary.index) == [*FILE_NAMES, "lambda_y"]
     assert summary["mean"].notna().all() and (summary["sd"] > 0).all()
 
 
@@ -122,18 +131,3 @@ def test_bad_inputs_are_one_line_errors(tmp_path, paper_config):
     bare = tmp_path / "bare.parquet"
     write_table(draws, bare)
     assert main(["posterior-netcdf", "--config", CONFIG, "--posterior", str(bare), "--out", str(tmp_path / "x.nc")]) == 2
-
-
-def test_readme_arviz_block_runs(netcdf, monkeypatch):
-    """The README's "Posteriors in ArviZ" block as written, on a file this test wrote (the path swapped)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    readme = (REPO / "README.md").read_text()
-    section = readme.split("## Posteriors in ArviZ", 1)[1].split("\n## ", 1)[0]
-    code = re.findall(r"```python\n(.*?)```", section, re.S)[0]
-    assert '"results/posterior/joint.nc"' in code
-    code = code.replace('"results/posterior/joint.nc"', repr(str(netcdf[0])))
-    scope: dict = {}
-    exec(compile(code, "README.md", "exec"), scope)
-    assert list(scope["summary"].index)[:2] == ["A", "B"]

@@ -75,3 +75,5 @@ def test_bad_input_is_named():
     assert posterior_box(summary, ["B"]) == {"B": (0.2, 0.4)}
     with pytest.raises(InputError, match="no rows for inputs \\['C'\\]"):
         posterior_box(summary, ["C"])
+    in_mpa = pd.DataFrame({"parameter": ["A_MPa"], "q05": [150.0], "q95": [250.0]})   # Posterior.summary()'s rows
+    assert posterior_box(in_mpa, ["A"], {"A": ("A_MPa", "MPa", 1.0e5)}) == {"A": (0.0015, 0.0025)}

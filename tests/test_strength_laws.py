@@ -394,3 +394,15 @@ def test_cli_errors_are_one_line(capsys, argv, message):
     assert main(["flow-stress", *argv]) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("temperature, molten", [(310.0, False), (893.0, True), (3000.0, True)])
+def test_cli_says_when_the_state_is_molten(capsys, temperature, molten):
+    """Johnson-Cook's flow stress is zero at and above T_melt_K (893 K by default): the table says why."""
+    assert main(["flow-stress", "--model", "jc", *JC_ARGS, "--strain-rate", "1e5", "--temperature", str(temperature),
+                 "--points", "3"]) == 0
+    out = capsys.readouterr().out
+    note = f"# molten: T {temperature:g} K is at or above the law's melting temperature 893 K"
+    assert (note in out) == molten
+    stress = [float(line.split()[1]) for line in out.splitlines()[-3:]]
+    assert (max(stress) == 0.0) == molten

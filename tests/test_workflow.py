@@ -1,8 +1,9 @@
 """The Snakemake workflow on the quick study: every figure from one command, partial reruns decided
 by config slices (not mtimes), and an interrupted fan-out finishing with identical results.
 
-One quick study (config/quick.yaml, about a minute on 2 idle cores) is run into a temporary results
-directory and shared by the tests of this module; the rerun checks are dry runs against it.
+One quick study (config/quick.yaml, about two minutes on 2 idle cores) is run into a temporary results
+directory and shared by the tests of the session (`quick_study`, tests/conftest.py); the rerun checks
+are dry runs against it.
 """
 
 from __future__ import annotations
@@ -66,14 +67,10 @@ def pending_jobs(*config_files, target="all") -> dict[str, int]:
     return jobs
 
 
-@pytest.fixture(scope="module")
-def study(tmp_path_factory):
-    """The quick study run once, end to end: (results directory, its config overlay)."""
-    root = tmp_path_factory.mktemp("quick")
-    results = root / "results"
-    config = overlay(root / "results.yaml", study={"results_dir": str(results)})
-    snakemake("all", "--cores", "2", config_files=[config])
-    return results, config
+@pytest.fixture
+def study(quick_study):
+    """The session's quick study (tests/conftest.py): (results directory, its config overlay)."""
+    return quick_study
 
 
 def test_every_figure_is_a_real_image(study):
@@ -149,6 +146,18 @@ def test_next_shot_target_ranks_the_quick_candidates(study):
 
 def test_nothing_to_redo(study):
     assert pending_jobs(study[1]) == {}
+
+
+def test_the_settings_of_the_last_run_have_a_stable_path(study, tmp_path):
+    """{results}/config/effective.yaml points at the content-named config the run's jobs read; a dry run with
+    other settings writes its own content-named file and leaves the link (and the running jobs' file) alone."""
+    results, config = study
+    link = results / "config" / "effective.yaml"
+    assert link.is_symlink() and re.fullmatch(r"effective-[0-9a-f]{12}\.yaml", os.readlink(link)), os.readlink(link)
+    pointed = link.resolve()
+    assert load_config(link)["design"]["n_runs"] == 40 and load_config(link)["study"]["results_dir"] == str(results)
+    assert pending_jobs(config, overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
+    assert link.resolve() == pointed and len(list(link.parent.glob("effective-*.yaml"))) >= 2
 
 
 def test_sampler_setting_reruns_no_simulation(study, tmp_path):

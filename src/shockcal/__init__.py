@@ -8,8 +8,9 @@ sources) -> `design` (which runs) -> `velocimetry` (records and features) -> `em
 
 The array API for notebooks (README, "From a notebook"): `PCGPEmulator` and its `EmulatorSettings`
 (fit, predict, cross-validate, save, load), `Problem` (a predictive model, measured features and a
-prior box), `SamplerSettings` and `sample` (the posterior). Imported on first use, so the command
-line starts without them.
+prior box), `SamplerSettings` and `sample` (the posterior); `load_study(results_dir)`, a finished
+study's posteriors (as `Posterior` and ArviZ InferenceData), emulator and measured features. Imported
+on first use, so the command line starts without them.
 """
 
 from shockcal._lazy import lazy_exports
@@ -23,4 +24,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "SamplerSettings": "shockcal.inference.sampler",
     "sample": "shockcal.inference.sampler",
     "Posterior": "shockcal.inference.sampler",
+    "load_study": "shockcal.inference.study_results",
 })

@@ -15,6 +15,7 @@ from shockcal.study.workflow import (
     chunk_count,
     chunk_rows,
     export_to_jobs,
+    point_stable_name,
     write_if_changed,
 )
 
@@ -28,6 +29,13 @@ _EFFECTIVE_TEXT = yaml.safe_dump(config, sort_keys=True)
 EFFECTIVE_CONFIG = f"{RESULTS}/config/effective-{hashlib.sha256(_EFFECTIVE_TEXT.encode()).hexdigest()[:12]}.yaml"
 write_if_changed(EFFECTIVE_CONFIG, _EFFECTIVE_TEXT)
 export_to_jobs(EFFECTIVE_CONFIG)
+
+
+# {RESULTS}/config/effective.yaml: a symlink to the merged config of the last run that started jobs (not a
+# dry run's), the stable path to reuse the study's settings with `shockcal --config`; jobs never read it
+onstart:
+    point_stable_name(EFFECTIVE_CONFIG)
+
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
 

@@ -87,18 +87,27 @@ def sobol_indices(function: Callable[[np.ndarray], np.ndarray], names: list[str]
     return pd.concat(parts, ignore_index=True)[["output", *COLUMNS]]
 
 
-def posterior_box(summary: pd.DataFrame, names: list[str], low: str = "q05", high: str = "q95"
-                  ) -> dict[str, tuple[float, float]]:
-    """The box of a posterior's quantiles: input -> (`low`, `high`) from its summary table (`parameter`,
-    and the quantile columns, e.g. `Posterior.summary()`'s weighted q05 and q95; native units)."""
+def posterior_box(summary: pd.DataFrame, names: list[str], columns: Mapping[str, tuple[str, str, float]] | None = None,
+                  low: str = "q05", high: str = "q95") -> dict[str, tuple[float, float]]:
+    """The box of a posterior's quantiles in the inputs' native units: input -> (`low`, `high`) from its
+    summary table (`parameter`, and the quantile columns, e.g. `Posterior.summary()`'s weighted q05 and q95).
+
+    Args:
+        summary: the summary table, its rows in user units (`Posterior.summary()`).
+        names: the inputs (native names).
+        columns: input -> (its row's name, its user unit, the factor from native to user units;
+            `shockcal.units.user_columns`); None: rows named and valued as the inputs.
+    """
     missing = [c for c in ["parameter", low, high] if c not in summary.columns]
     if missing:
         raise InputError(f"posterior summary: columns {missing} missing")
     table = summary.set_index("parameter")
-    absent = [n for n in names if n not in table.index]
+    row = {n: (n, "", 1.0) if columns is None else columns[n] for n in names}
+    absent = [row[n][0] for n in names if row[n][0] not in table.index]
     if absent:
         raise InputError(f"posterior summary: no rows for inputs {absent}")
-    return {n: (float(table.loc[n, low]), float(table.loc[n, high])) for n in names}
+    return {n: (float(table.loc[row[n][0], low]) / row[n][2], float(table.loc[row[n][0], high]) / row[n][2])
+            for n in names}
 
 
 def emulator_sobol(emulator, shots: list[str], bounds: Mapping[str, tuple[float, float]], n_base: int, seed: int,

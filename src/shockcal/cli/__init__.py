@@ -39,11 +39,41 @@ STAGE_MODULES = [
 ]
 
 
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's wrapping of a command's description, paragraph by paragraph, and its example (the
+    epilog) kept line for line as written."""
+
+    def _fill_text(self, text, width, indent):
+        if text.startswith(EXAMPLE):
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return "\n\n".join(super(HelpFormatter, self)._fill_text(part, width, indent)
+                           for part in text.strip().split("\n\n"))
+
+
+EXAMPLE = "example:"
+
+
+def add_command(subparsers, name: str, help: str, example: str, description: str | None = None):
+    """A subcommand's parser: `help` is its line in `shockcal --help` and, unless a longer
+    `description` is given, the top of its own --help; `example` (a command line, or a few) is shown
+    below its options, as written. Returns the parser (add its arguments and `func`)."""
+    return subparsers.add_parser(name, help=help, description=description or _sentence(help),
+                                 epilog=f"{EXAMPLE}\n" + "\n".join(f"  {line}" for line in example.strip().splitlines()),
+                                 formatter_class=HelpFormatter)
+
+
+def _sentence(help: str) -> str:
+    """A parser's one-line help as the sentence that opens its own --help ('%%' is argparse's escaped '%')."""
+    text = help.replace("%%", "%")
+    return f"{text[0].upper()}{text[1:]}."
+
+
 def add_config_argument(parser, help: str = "study config YAML") -> None:
-    """`--config`, defaulting to $SHOCKCAL_CONFIG (the workflow sets it to the merged config)."""
-    default = os.environ.get("SHOCKCAL_CONFIG")
-    parser.add_argument("--config", default=default, required=default is None,
+    """`--config`, optional on the command line: it defaults to $SHOCKCAL_CONFIG (the workflow sets it to
+    the merged config); `main` stops with one line when neither is given."""
+    parser.add_argument("--config", default=os.environ.get("SHOCKCAL_CONFIG"),
                         help=f"{help} (default: $SHOCKCAL_CONFIG)")
+    parser.set_defaults(needs_config=True)
 
 
 def parse_pairs(pairs: list[str], option: str) -> dict[str, str]:
@@ -117,6 +147,8 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
                         format="%(asctime)s %(name)s %(levelname)s: %(message)s", stream=sys.stderr)
     try:
+        if getattr(args, "needs_config", False) and not args.config:
+            raise InputError("--config: no study config given; pass --config FILE or set $SHOCKCAL_CONFIG")
         return int(args.func(args) or 0)
     except ShockcalError as exc:
         print(f"shockcal {args.command}: error: {exc}", file=sys.stderr)

@@ -2,17 +2,29 @@
 (coverage on synthetic truth) and `shockcal coverage` (merging the check's batches).
 
 calibrate reads the emulator directory and the observed features table and writes OUT (equal-weight
-draws), OUT_summary.parquet and OUT_weighted.parquet (the sampler's weighted draws with their log
-weights: the exact result); config keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`,
-`inputs`, study.seed (shockcal.study.stages declares them)."""
+draws, native units), OUT_summary.parquet (in MPa, GPa and m/s) and OUT_weighted.parquet (the sampler's
+weighted draws with their log weights: the exact result; `shockcal.inference.posterior_files`); config
+keys: `calibration`, `observed.sd_fraction`, `checks.observed_units`, `inputs`, study.seed
+(shockcal.study.stages declares them)."""
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs, parse_span, unique_shots
+from shockcal.cli import add_command, add_config_argument, parse_pairs, parse_span, unique_shots
+
+EXAMPLE_CALIBRATE = """\
+shockcal calibrate --config config/config.yaml --emulator results/emulator --shots 104S 105S 106S \\
+    --observed results/features/observed.parquet --out results/posterior/joint.parquet"""
+EXAMPLE_CALIBRATE_CHECK = """\
+shockcal calibrate-check --config config/config.yaml --emulator results/emulator --shots 104S \\
+    --trials 10 --out results/check/104S_trials.parquet"""
+EXAMPLE_COVERAGE = """\
+shockcal coverage --trials results/check/coverage/emulator/batch-*.parquet \\
+    --out results/posterior/coverage_emulator.parquet"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("calibrate", help="posterior of the inputs given measured features (nested sampling)")
+    p = add_command(subparsers, "calibrate", example=EXAMPLE_CALIBRATE,
+                    help="posterior of the inputs given measured features (nested sampling)")
     add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--shots", required=True, nargs="+", help="shots calibrated together (one = single-shot)")
@@ -22,7 +34,8 @@ def register(subparsers) -> None:
     p.add_argument("--n-eff", type=int, help="override calibration.n_eff (effective sample size to reach)")
     p.set_defaults(func=run)
 
-    c = subparsers.add_parser("calibrate-check", help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
+    c = add_command(subparsers, "calibrate-check", example=EXAMPLE_CALIBRATE_CHECK,
+                    help="coverage of 90%% intervals on synthetic truth (emulator or hydrocode)")
     add_config_argument(c)
     c.add_argument("--emulator", required=True)
     c.add_argument("--shots", required=True, nargs="+")
@@ -42,7 +55,8 @@ def register(subparsers) -> None:
     c.add_argument("--draws-out", help="also write every trial's equal-weight posterior draws (Parquet; trial, run)")
     c.set_defaults(func=run_check)
 
-    m = subparsers.add_parser("coverage", help="merge per-trial tables of calibrate-check batches; print the coverage")
+    m = add_command(subparsers, "coverage", example=EXAMPLE_COVERAGE,
+                    help="merge per-trial tables of calibrate-check batches; print the coverage")
     m.add_argument("--trials", required=True, nargs="+", help="per-trial tables (calibrate-check --out)")
     m.add_argument("--out", required=True, help="merged per-trial table (Parquet)")
     m.set_defaults(func=run_coverage)
@@ -61,19 +75,12 @@ def study_emulator(directory, config: dict):
     return emulator
 
 
-def companion_path(out, kind: str = "summary"):
-    """The table of `kind` ("summary", "weighted") beside the posterior samples `out`."""
-    from pathlib import Path
-
-    out = Path(out)
-    return out.with_name(f"{out.stem}_{kind}.parquet")
-
-
 def run(args) -> int:
     import logging
 
     from shockcal.inference.calibration import calibrate
-    from shockcal.io import read_table, write_table
+    from shockcal.inference.posterior_files import write_posterior
+    from shockcal.io import read_table
     from shockcal.study.adapters import calibration_settings
     from shockcal.study.stages import load_stage_config
 
@@ -85,21 +92,12 @@ def run(args) -> int:
     if args.n_eff is not None:
         settings = settings.with_sampler(n_eff=args.n_eff)
     posterior = calibrate(emulator, args.shots, observed, settings, source=args.observed)
-    info, summary = posterior.info(), posterior.summary()
-    meta = {"table": "posterior samples", **info,
-            "columns": "equal-weight draws resampled from nautilus's weighted ones: inputs in `units`; lambda_y (-); "
-                       "log_likelihood (at the draw)"}
-    write_table(posterior.draws, args.out, meta)
-    write_table(summary, companion_path(args.out), {"table": "posterior summary", "shots": info["shots"]})
-    write_table(posterior.weighted_table(), companion_path(args.out, "weighted"),
-                {**meta, "table": "posterior weighted draws",
-                 "columns": "nautilus's weighted draws (the exact result): inputs in `units`; lambda_y (-); log_weight "
-                            "(normalised, logsumexp = 0); log_likelihood"})
+    info = write_posterior(posterior, args.out)
     logging.getLogger("shockcal.calibrate").info(
         "posterior of %s (Kish ESS %.0f, %d draws written, %d distinct, %d likelihood evaluations, "
         "log evidence %.3f +- %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(posterior.draws),
         info["distinct_draws"], info["likelihood_evaluations"], info["log_evidence"], info["log_evidence_sd"],
-        summary.to_string(index=False, float_format="%.4g"))
+        posterior.summary().to_string(index=False, float_format="%.4g"))
     return 0
 
 

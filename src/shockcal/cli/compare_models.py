@@ -15,10 +15,17 @@ and lambda_y (the error scale, not an input): the law's own parameters and its s
 
 from __future__ import annotations
 
+from shockcal.cli import add_command
+
+EXAMPLE_COMPARE_MODELS = """\
+shockcal compare-models --model johnson-cook=results/models/johnson-cook \\
+    --model steinberg-guinan=results/models/steinberg-guinan --out results/models/evidence.csv"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("compare-models", help="the strength laws' log evidence and Bayes factors vs Johnson-Cook",
-                              description=__doc__)
+    p = add_command(subparsers, "compare-models", example=EXAMPLE_COMPARE_MODELS,
+                    help="the strength laws' log evidence and Bayes factors vs Johnson-Cook",
+                    description=__doc__)
     p.add_argument("--model", action="append", required=True, metavar="NAME=RESULTS_DIR",
                    help="a law and its study's results_dir (repeat; johnson-cook required)")
     p.add_argument("--out", required=True, help="the table (CSV), e.g. results/models/evidence.csv")

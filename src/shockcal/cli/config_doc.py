@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_command
+
+EXAMPLE_CONFIG_DOC = """\
+shockcal config-doc --out docs/configuration.md"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("config-doc", help="render the configuration reference (docs/configuration.md) "
+    p = add_command(subparsers, "config-doc", example=EXAMPLE_CONFIG_DOC,
+                    help="render the configuration reference (docs/configuration.md) "
                                                  "from the config schema")
     p.add_argument("--out", help="write the page here (default: print it), e.g. docs/configuration.md")
     p.add_argument("--check", action="store_true",

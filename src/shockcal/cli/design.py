@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_DESIGN = """\
+shockcal design --config config/config.yaml --out results/training/design.parquet"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("design", help="write the design table (seeded Latin hypercube or the config's design file)")
+    p = add_command(subparsers, "design", example=EXAMPLE_DESIGN,
+                    help="write the design table (seeded Latin hypercube or the config's design file)")
     add_config_argument(p)
     p.add_argument("--out", required=True, help="output Parquet design table")
     p.add_argument("--n-runs", type=int, default=None, help="override design.n_runs")

@@ -7,14 +7,22 @@ emulate reads the design and each shot's features table and writes the emulator 
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_command, add_config_argument, parse_pairs
 
 HELD_OUT = ("kfold", "outer")
 UNITS = {"simulated": "m/s", "predicted": "m/s", "predicted_sd": "m/s"}
 
+EXAMPLE_EMULATE = """\
+shockcal emulate --config config/config.yaml --design results/training/design.parquet \\
+    --features 104S=results/training/features/104S.parquet 105S=results/training/features/105S.parquet \\
+    106S=results/training/features/106S.parquet --out results/emulator"""
+EXAMPLE_EMULATE_CV = """\
+shockcal emulate-cv --emulator results/emulator --folds 5"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("emulate", help="fit the emulator; write it and its cross-validation tables")
+    p = add_command(subparsers, "emulate", example=EXAMPLE_EMULATE,
+                    help="fit the emulator; write it and its cross-validation tables")
     add_config_argument(p)
     p.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
@@ -29,7 +37,8 @@ def register(subparsers) -> None:
                    help="output directory (emulator.json, emulator.npz, cv.parquet, cv_heldout.parquet, cv_rmse.csv)")
     p.set_defaults(func=run)
 
-    cv = subparsers.add_parser("emulate-cv", help="print the cross-validation table of a fitted emulator "
+    cv = add_command(subparsers, "emulate-cv", example=EXAMPLE_EMULATE_CV,
+                     help="print the cross-validation table of a fitted emulator "
                                                   "(loo_closed_form, kfold, outer)")
     cv.add_argument("--emulator", required=True, help="emulator directory")
     cv.add_argument("--folds", type=int, help="recompute K-fold with this many folds (refits per fold)")

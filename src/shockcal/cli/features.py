@@ -4,14 +4,20 @@ from __future__ import annotations
 
 import logging
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
 
 log = logging.getLogger("shockcal.velocimetry.features")
 UNITS = {"t_*": "us", "v_*": "m/s", "readout_sd_v_*": "m/s", "noise_sd_m_s": "m/s", "readout_half_window_ns": "ns"}
 
+EXAMPLE_FEATURES = """\
+shockcal features --config config/config.yaml --shot 104S --record Data_S104S.txt --out 104S_measured.parquet"""
+EXAMPLE_OBSERVED = """\
+shockcal observed --config config/config.yaml --out results/features/observed.parquet"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("features", help="extract the features of simulated traces or of a measured record")
+    p = add_command(subparsers, "features", example=EXAMPLE_FEATURES,
+                    help="extract the features of simulated traces or of a measured record")
     add_config_argument(p)
     p.add_argument("--shot", required=True, help="shot name (its analysis window is in the config), or a next-shot "
                    "candidate's (its window derived from its reference shot's; no failed-run budget)")
@@ -29,7 +35,8 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, help="output Parquet table")
     p.set_defaults(func=run)
 
-    o = subparsers.add_parser("observed", help="write the measured features of every shot (config values or records)")
+    o = add_command(subparsers, "observed", example=EXAMPLE_OBSERVED,
+                    help="write the measured features of every shot (config values or records)")
     add_config_argument(o)
     o.add_argument("--out", required=True)
     o.set_defaults(func=run_observed)

@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_FIGURES = """\
+shockcal figures --config config/config.yaml --list
+shockcal figures --config config/config.yaml --figure fig07_marginals --out-dir results/figures"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("figures", help="draw one figure of the study as PNG/PDF (see --list)")
+    p = add_command(subparsers, "figures", example=EXAMPLE_FIGURES,
+                    help="draw one figure of the study as PNG/PDF (see --list)")
     add_config_argument(p, "study config YAML (figures.formats, figures.dpi)")
     p.add_argument("--figure", help="figure name, e.g. fig07_marginals")
     p.add_argument("--out-dir", default="results/figures", help="folder for <figure>.<format>")

@@ -2,14 +2,22 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_command
+
+EXAMPLE_FLOW_STRESS = """\
+shockcal flow-stress --model johnson-cook --param A_MPa=335 --param B_MPa=425 --param C=0.0335 \\
+    --param n=0.42 --param m=1.225 --strain-rate 1e5 --temperature 298"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "flow-stress", help="tabulate a strength law's flow stress (MPa) against plastic strain at one state",
-        description="Flow stress (MPa) of a strength law (johnson-cook, steinberg-guinan, ptw, zerilli-armstrong) "
-                    "against equivalent plastic strain, at a constant strain rate, temperature, pressure and density "
-                    "ratio. Parameters by their unit-suffixed names (shockcal.hydro.laws.declarations), e.g. "
-                    "--param A_MPa=270; material constants have defaults.")
+    p = add_command(subparsers, "flow-stress", example=EXAMPLE_FLOW_STRESS,
+                    help="tabulate a strength law's flow stress (MPa) against plastic strain at one state",
+                    description="Flow stress (MPa) of a strength law (johnson-cook, steinberg-guinan, ptw, "
+                                "zerilli-armstrong) against equivalent plastic strain, at a constant strain rate, "
+                                "temperature, pressure and density ratio. Parameters by their unit-suffixed names "
+                                "(shockcal.hydro.laws.declarations), e.g. --param A_MPa=270; material constants have "
+                                "defaults. At or above the law's melting temperature the flow stress is zero, and the "
+                                "table says so.")
     p.add_argument("--model", required=True,
                    help="johnson-cook (jc), steinberg-guinan (sg), ptw, zerilli-armstrong (za)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a parameter (repeat)")
@@ -47,7 +55,7 @@ def run(args) -> int:
     import numpy as np
 
     from shockcal.errors import InputError
-    from shockcal.hydro.laws import flow_stress_curve, get_law, shear_modulus_gpa
+    from shockcal.hydro.laws import flow_stress_curve, get_law, melt_temperature_K, shear_modulus_gpa
 
     law = get_law(args.model)
     values = parse_params(args.param)
@@ -76,6 +84,10 @@ def run(args) -> int:
     G = shear_modulus_gpa(law, values, args.temperature, args.pressure, args.density_ratio)
     if G is not None:
         print(f"# shear modulus {G:.6g} GPa")
+    melt = melt_temperature_K(law, values, args.density_ratio)
+    if melt is not None and args.temperature >= melt:
+        print(f"# molten: T {args.temperature:g} K is at or above the law's melting temperature {melt:.6g} K "
+              f"(at rho/rho0 {args.density_ratio:g}), where its flow stress is zero")
     print(f"{'plastic_strain':>14} {'flow_stress_MPa':>16}")
     for eps, y in zip(strains, stress):
         print(f"{eps:14.4f} {y:16.6g}")

@@ -10,12 +10,17 @@ Writes `--out` (CSV; shockcal.campaign.release.RELEASE_COLUMNS) and, with `--fig
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_MODEL_PREDICTIONS = """\
+shockcal model-predictions --config config/config.yaml --model johnson-cook=results/models/johnson-cook \\
+    --model steinberg-guinan=results/models/steinberg-guinan --out results/models/release.csv"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("model-predictions", help="each law's posterior predictive runs: release timing and "
-                              "figures", description=__doc__)
+    p = add_command(subparsers, "model-predictions", example=EXAMPLE_MODEL_PREDICTIONS,
+                    help="each law's posterior predictive runs: release timing and "
+                    "figures", description=__doc__)
     add_config_argument(p, "study config YAML (the shots, records and analysis windows)")
     p.add_argument("--model", action="append", required=True, metavar="NAME=RESULTS_DIR",
                    help="a law and its study's results_dir (repeat)")

@@ -16,19 +16,29 @@ noise. Config keys: next_shot, observed.sd_fraction, study.seed, inputs.
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_command, add_config_argument, parse_pairs
+
+EXAMPLE_NEXT_SHOT_DESIGN = """\
+shockcal next-shot-design --config config/config.yaml --candidate 104S-repeat \\
+    --posterior results/posterior/joint.parquet --out results/104S-repeat/design.parquet"""
+EXAMPLE_SUGGEST_SHOT = """\
+shockcal suggest-shot --config config/config.yaml \\
+    --designs 104S-repeat=results/104S-repeat/design.parquet 105S-repeat=results/105S-repeat/design.parquet \\
+    --features 104S-repeat=results/104S-repeat/features/104S-repeat.parquet \\
+    105S-repeat=results/105S-repeat/features/105S-repeat.parquet --out results/next_shot/ranking.csv"""
 
 
 def register(subparsers) -> None:
-    d = subparsers.add_parser("next-shot-design",
-                              help="a next-shot candidate's design: joint-posterior draws at its conditions")
+    d = add_command(subparsers, "next-shot-design", example=EXAMPLE_NEXT_SHOT_DESIGN,
+                    help="a next-shot candidate's design: joint-posterior draws at its conditions")
     add_config_argument(d)
     d.add_argument("--candidate", required=True, help="candidate name (next_shot.candidates)")
     d.add_argument("--posterior", required=True, help="the joint posterior's equal-weight draws (Parquet or CSV)")
     d.add_argument("--out", required=True, help="output Parquet design of the candidate's runs")
     d.set_defaults(func=run_design)
 
-    s = subparsers.add_parser("suggest-shot", help="rank the next-shot candidates by expected information gain")
+    s = add_command(subparsers, "suggest-shot", example=EXAMPLE_SUGGEST_SHOT,
+                    help="rank the next-shot candidates by expected information gain")
     add_config_argument(s)
     s.add_argument("--designs", nargs="+", required=True, help="CANDIDATE=DESIGN pairs (next-shot-design's tables)")
     s.add_argument("--features", nargs="+", required=True, help="CANDIDATE=FEATURES pairs (their runs' features)")

@@ -13,12 +13,23 @@ inputs, material, the shots' plates, moduli and windows.
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_command, add_config_argument, parse_pairs
+
+EXAMPLE_NEXT_SHOT_CHECK_TRUTHS = """\
+shockcal next-shot-check-truths --config config/config.yaml --posterior results/posterior/joint.parquet \\
+    --candidates 104S-repeat 106S-repeat --out results/next_shot_truth/design.parquet \\
+    --candidate-designs 104S-repeat=results/next_shot_truth/designs/104S-repeat.parquet \\
+    106S-repeat=results/next_shot_truth/designs/106S-repeat.parquet"""
+EXAMPLE_NEXT_SHOT_CHECK_SUMMARY = """\
+shockcal next-shot-check-summary --config config/config.yaml --ranking results/next_shot/ranking.csv \\
+    --posterior results/posterior/joint.parquet --baseline results/next_shot/check/baseline/draws.parquet \\
+    --candidates 104S-repeat=results/next_shot/check/104S-repeat/draws.parquet \\
+    106S-repeat=results/next_shot/check/106S-repeat/draws.parquet --out results/next_shot/check.csv"""
 
 
 def register(subparsers) -> None:
-    t = subparsers.add_parser("next-shot-check-truths",
-                              help="the next-shot check's truths: joint-posterior draws with each candidate's inputs")
+    t = add_command(subparsers, "next-shot-check-truths", example=EXAMPLE_NEXT_SHOT_CHECK_TRUTHS,
+                    help="the next-shot check's truths: joint-posterior draws with each candidate's inputs")
     add_config_argument(t)
     t.add_argument("--posterior", required=True, help="the joint posterior's equal-weight draws (Parquet or CSV)")
     t.add_argument("--candidates", required=True, nargs="+", help="the compared candidates (next_shot.candidates)")
@@ -28,8 +39,8 @@ def register(subparsers) -> None:
                    help="output Parquet design of each candidate's truth runs (the columns a candidate's runs read)")
     t.set_defaults(func=run_truths)
 
-    s = subparsers.add_parser("next-shot-check-summary",
-                              help="the next-shot check's realized gains and sds against the ranking's prediction")
+    s = add_command(subparsers, "next-shot-check-summary", example=EXAMPLE_NEXT_SHOT_CHECK_SUMMARY,
+                    help="the next-shot check's realized gains and sds against the ranking's prediction")
     add_config_argument(s)
     s.add_argument("--ranking", required=True, help="the ranking (results/next_shot/ranking.csv)")
     s.add_argument("--posterior", required=True, help="the joint posterior's equal-weight draws (the scores' marginals)")

@@ -3,17 +3,23 @@
 Reads the posterior written by `shockcal calibrate` (the equal-weight draws, the weighted draws beside
 them, their metadata: shots, measured features and their sd, units, sampler settings, evidence) and,
 for the joint posterior, the features of the hydrocode runs at its draws; writes OUT (.nc) with the
-groups of `shockcal.inference.inference_data`. Config keys: the `calibrate` stage's (the prior box; their
-sha256 is the file's `config_digest`).
+groups of `shockcal.inference.inference_data`, the inputs in the units a user reads (the posterior's
+`user_units` metadata; for a posterior written without it, `shockcal.study.config.input_user_units`).
+Config keys: the `calibrate` stage's (the prior box; their sha256 is the file's `config_digest`).
 """
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_pairs
+from shockcal.cli import add_command, add_config_argument, parse_pairs
+
+EXAMPLE_POSTERIOR_NETCDF = """\
+shockcal posterior-netcdf --config config/config.yaml --posterior results/posterior/joint.parquet \\
+    --out results/posterior/joint.nc"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("posterior-netcdf", help="a posterior as ArviZ InferenceData (netCDF) with provenance")
+    p = add_command(subparsers, "posterior-netcdf", example=EXAMPLE_POSTERIOR_NETCDF,
+                    help="a posterior as ArviZ InferenceData (netCDF) with provenance")
     add_config_argument(p)
     p.add_argument("--posterior", required=True,
                    help="equal-weight posterior draws (shockcal calibrate --out); *_weighted.parquet is read beside it")
@@ -28,7 +34,6 @@ def run(args) -> int:
     from pathlib import Path
 
     from shockcal import __version__
-    from shockcal.cli.calibrate import companion_path
     from shockcal.errors import InputError
     from shockcal.inference.inference_data import (
         config_digest,
@@ -37,8 +42,9 @@ def run(args) -> int:
         posterior_inference_data,
         write_inference_data,
     )
+    from shockcal.inference.posterior_files import companion_path
     from shockcal.io import read_table, read_table_metadata
-    from shockcal.study.config import prior_bounds
+    from shockcal.study.config import input_user_units, prior_bounds
     from shockcal.study.stages import load_stage_config
 
     logging.getLogger("arviz").setLevel(logging.WARNING)       # its preview notes of packages not installed
@@ -62,8 +68,9 @@ def run(args) -> int:
              **{key: meta[key] for key in ("sampler", "n_live", "n_eff_target", "seed", "cube_power",
                                            "log_evidence", "log_evidence_sd", "likelihood_evaluations",
                                            "ess_kish", "weighted_draws", "retained", "distinct_draws") if key in meta}}
+    user_units = meta.get("user_units") or input_user_units(config)
     idata = posterior_inference_data(
-        draws, names, units=meta["units"], lower={k: b[0] for k, b in bounds.items()},
+        draws, names, units=meta["units"], user_units=user_units, lower={k: b[0] for k, b in bounds.items()},
         upper={k: b[1] for k, b in bounds.items()}, observed=observed, observed_sd=observed_sd,
         weighted=weighted, predictive=predictive, attrs=attrs)
     out = write_inference_data(idata, args.out)

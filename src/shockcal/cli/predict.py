@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_PREDICT = """\
+shockcal predict --config config/config.yaml --posterior results/posterior/joint.parquet \\
+    --out results/predict/design.parquet"""
+EXAMPLE_PREDICT_EMULATOR = """\
+shockcal predict-emulator --config config/config.yaml --design results/predict/design.parquet \\
+    --emulator results/emulator --out results/predict/emulator.parquet"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("predict", help="draw joint-posterior samples as a design table for hydrocode runs")
+    p = add_command(subparsers, "predict", example=EXAMPLE_PREDICT,
+                    help="draw joint-posterior samples as a design table for hydrocode runs")
     add_config_argument(p)
     p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
     p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
@@ -14,7 +22,8 @@ def register(subparsers) -> None:
     p.add_argument("--seed", type=int, default=None, help="override the seed (default: the study's posterior_draws stream)")
     p.set_defaults(func=run)
 
-    e = subparsers.add_parser("predict-emulator", help="emulator predictions of the features at a design's rows")
+    e = add_command(subparsers, "predict-emulator", example=EXAMPLE_PREDICT_EMULATOR,
+                    help="emulator predictions of the features at a design's rows")
     add_config_argument(e)
     e.add_argument("--design", required=True, help="design table, e.g. the posterior draws of `shockcal predict`")
     e.add_argument("--emulator", required=True, help="emulator directory written by `shockcal emulate`")

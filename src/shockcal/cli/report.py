@@ -2,8 +2,8 @@
 and as an HTML table (Snakemake 9's report shows HTML inline and offers CSV only as a download).
 
 From the posteriors (`shockcal calibrate` output and its metadata) it writes `posterior_summary.csv`
-(every calibration's weighted summary, one row per calibration and parameter, display units beside the
-Table IV ones) and `evidence.csv` (log evidence with its sd, Kish ESS, likelihood evaluations per
+(every calibration's weighted summary, one row per calibration and parameter, in MPa, GPa and m/s with the
+unit in the parameter's name and the `unit` column) and `evidence.csv` (log evidence with its sd, Kish ESS, likelihood evaluations per
 calibration); from the emulator's `cv_rmse.csv`, `cross_validation.csv`; from the synthetic-truth
 checks' merged tables (`make check`), `coverage.csv` (per truth and parameter); from the Sobol table
 (`shockcal sensitivity`), `sobol.html` only (its CSV is the sensitivity stage's). Each table is written
@@ -12,11 +12,16 @@ only when its inputs are given. No config is read.
 
 from __future__ import annotations
 
-from shockcal.cli import parse_pairs
+from shockcal.cli import add_command, parse_pairs
+
+EXAMPLE_REPORT_TABLES = """\
+shockcal report-tables --posteriors joint=results/posterior/joint.parquet \\
+    --cv-rmse results/emulator/cv_rmse.csv --out-dir results/report"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("report-tables", help="summary tables (CSV) of posteriors, evidence, CV and coverage "
+    p = add_command(subparsers, "report-tables", example=EXAMPLE_REPORT_TABLES,
+                    help="summary tables (CSV) of posteriors, evidence, CV and coverage "
                                                     "for the report")
     p.add_argument("--posteriors", nargs="+", default=[], metavar="NAME=POSTERIOR",
                    help="calibrations' equal-weight draws (shockcal calibrate --out); their _summary.parquet is read")
@@ -54,8 +59,8 @@ def run(args) -> int:
 
     import pandas as pd
 
-    from shockcal.cli.calibrate import companion_path
     from shockcal.inference.coverage import coverage_table
+    from shockcal.inference.posterior_files import companion_path
     from shockcal.io import read_table, read_table_metadata
 
     out = Path(args.out_dir)
@@ -73,7 +78,7 @@ def run(args) -> int:
                              "draws": meta.get("retained"), "distinct_draws": meta.get("distinct_draws")})
         summary = pd.concat(summaries, ignore_index=True)
         summary = summary[["calibration", *[c for c in summary.columns if c != "calibration"]]]
-        written += _write(summary, out, "posterior_summary", "Posterior summaries (Table IV units)")
+        written += _write(summary, out, "posterior_summary", "Posterior summaries (MPa, GPa, m/s: the unit in each name)")
         written += _write(pd.DataFrame(evidence), out, "evidence", "Log evidence per calibration")
     if args.cv_rmse:
         written += _write(read_table(args.cv_rmse), out, "cross_validation", "Emulator cross-validation (m/s)")

@@ -2,15 +2,20 @@
 and over the box of the joint posterior's 5-95% quantiles (shockcal.campaign.sensitivity says why a box).
 
 Config keys: `sensitivity` (n_base, resamples), `inputs` (the prior box), study.seed (the
-`sensitivity` stream)."""
+`sensitivity` stream), the shots' shear-modulus inputs (which summary rows are moduli, in GPa)."""
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_SENSITIVITY = """\
+shockcal sensitivity --config config/config.yaml --emulator results/emulator \\
+    --posterior-summary results/posterior/joint_summary.parquet --out results/sensitivity/sobol.csv"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("sensitivity", help="Sobol indices of the emulated features over the prior and posterior")
+    p = add_command(subparsers, "sensitivity", example=EXAMPLE_SENSITIVITY,
+                    help="Sobol indices of the emulated features over the prior and posterior")
     add_config_argument(p)
     p.add_argument("--emulator", required=True, help="emulator directory (shockcal emulate --out)")
     p.add_argument("--posterior-summary", help="the joint posterior's summary (q05, q95 per input): adds the "
@@ -32,7 +37,7 @@ def run(args) -> int:
     from shockcal.emulator.study_emulator import Emulator
     from shockcal.io import atomic_path, read_table, write_table
     from shockcal.seeds import stream_seed
-    from shockcal.study.config import prior_bounds
+    from shockcal.study.config import input_columns, prior_bounds
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "sensitivity")
@@ -44,7 +49,7 @@ def run(args) -> int:
     domains = {"prior": prior}
     if args.posterior_summary:
         names = [k for k in prior if k in emulator.required_inputs(emulator.shots)]
-        domains["posterior_q05_q95"] = posterior_box(read_table(args.posterior_summary), names)
+        domains["posterior_q05_q95"] = posterior_box(read_table(args.posterior_summary), names, input_columns(config))
     log = logging.getLogger("shockcal.campaign.sensitivity")
     parts = []
     for domain, bounds in domains.items():

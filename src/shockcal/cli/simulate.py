@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument, parse_span
+from shockcal.cli import add_command, add_config_argument, parse_span
+
+EXAMPLE_SIMULATE = """\
+shockcal simulate --config config/config.yaml --shot 104S --design results/training/design.parquet \\
+    --rows 0:10 --out results/training/simulations/104S/chunk-0.parquet"""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("simulate", help="run design rows through the hydrocode for one shot")
+    p = add_command(subparsers, "simulate", example=EXAMPLE_SIMULATE,
+                    help="run design rows through the hydrocode for one shot")
     add_config_argument(p)
     p.add_argument("--shot", required=True,
                    help="shot name in the config, e.g. 104S, or a next-shot candidate's (its design from next-shot-design)")

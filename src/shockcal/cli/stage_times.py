@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+from shockcal.cli import add_command
+
+EXAMPLE_STAGE_TIMES = """\
+shockcal stage-times --benchmarks results/quick/benchmarks"""
+
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("stage-times", help="wall and CPU seconds per workflow stage of a finished study")
+    p = add_command(subparsers, "stage-times", example=EXAMPLE_STAGE_TIMES,
+                    help="wall and CPU seconds per workflow stage of a finished study")
     p.add_argument("--benchmarks", default="results/benchmarks", help="the study's benchmark folder")
     p.set_defaults(func=run)
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.errors import InputError
+from shockcal.errors import InputError, number, shown
 from shockcal.hydro import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters
 from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
@@ -120,11 +120,11 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
         bad = ~np.isfinite(values.to_numpy(dtype=float))
         if bad.any():
             row = design.loc[bad, "run"].iloc[0]
-            raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({design.loc[bad, name].iloc[0]!r})")
+            raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({shown(design.loc[bad, name].iloc[0])})")
         design[name] = values.astype(float)
         if name in JOHNSON_COOK_INPUTS and (values < 0).any():
             row = design.loc[values < 0, "run"].iloc[0]
-            raise InputError(f"{path}: run {row}: parameter {name} = {values[values < 0].iloc[0]} is negative")
+            raise InputError(f"{path}: run {row}: parameter {name} = {number(values[values < 0].iloc[0])} is negative")
     design["run"] = design["run"].astype(np.int64)
     check_design_box(design, box, columns, path)
     kept = ["run", *(name for name in box.names() if name in design.columns)]   # other columns: notes, not inputs
@@ -189,7 +189,7 @@ class ShotMapping:
             bad = values <= 0
             if bad.any():
                 row = design.loc[bad, "run"].iloc[0]
-                raise InputError(f"{source}: run {row}: {label} = {values[bad][0]} must be positive for shot {self.shot}")
+                raise InputError(f"{source}: run {row}: {label} = {number(values[bad][0])} must be positive for shot {self.shot}")
 
 
 def write_design(design: pd.DataFrame, source: str, box: InputBox, path: str | Path) -> bool:

@@ -27,7 +27,7 @@ import pandas as pd
 from shockcal.design.tables import ShotMapping
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
-from shockcal.errors import InputError
+from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path
 from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
@@ -331,7 +331,7 @@ def training_data(design: pd.DataFrame, features: pd.DataFrame, shot: str, sourc
         if text.any():
             row = int(np.argmax(text.to_numpy()))
             raise InputError(f"{source}: row {row} (run {features['run'].iloc[row]}): {column} = "
-                             f"{features[column].iloc[row]!r} is not a number")
+                             f"{shown(features[column].iloc[row])} is not a number")
         features = features.assign(**{column: values.astype(float)})
     unknown = sorted(set(features["run"]) - set(design["run"]))
     if unknown:

@@ -16,8 +16,9 @@ Any strength law of `shockcal.hydro.laws` (docs/strength_laws.md), by its declar
 
 Laws with a shear-modulus law (Steinberg-Guinan, PTW) take G from it, cell by cell; the others
 (Johnson-Cook, Zerilli-Armstrong) need `shear_modulus_GPa`. Johnson-Cook given this way runs the
-solver's general return (every step, no floors), which gives the same traces bit for bit as
-`ShotParameters`' floored one, only slower (tests/test_hydro_laws.py).
+solver's general return (every step, no floors), which gives the same traces as `ShotParameters`'
+floored one (at the rounding floor; bit for bit on the machines measured), only slower
+(tests/test_hydro_laws.py).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from typing import NamedTuple
 
 from shockcal.errors import InputError
 from shockcal.hydro.laws import code_parameters, get_law
+from shockcal.hydro.rules import check_fields
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA, MBAR_TO_MPA
 
 # The Johnson-Cook inputs every shot shares (SPEC section 3), as the design tables name them.
@@ -49,7 +51,9 @@ class TableIV(NamedTuple):
 
 @dataclass(frozen=True)
 class ShotParameters:
-    """The inputs of one run of one shot, in user units.
+    """The inputs of one run of one shot, in user units; checked on creation (`shockcal.hydro.rules`: an
+    InputError naming the field: Johnson-Cook parameters >= 0, a positive shear modulus, an impact velocity
+    in (0, MAX_IMPACT_VELOCITY_M_S]).
 
     Args:
         A_MPa: Johnson-Cook yield stress A (MPa).
@@ -69,6 +73,10 @@ class ShotParameters:
     velocity_m_s: float
     shear_modulus_GPa: float
     _table_iv: TableIV | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        check_fields(self, {**dict.fromkeys(("A_MPa", "B_MPa", "C", "n", "m"), "nonnegative"),
+                            "velocity_m_s": "impact_velocity_m_s", "shear_modulus_GPa": "positive"})
 
     @classmethod
     def from_table_iv(cls, A_Mbar: float, B_Mbar: float, C: float, n: float, m: float, velocity_cm_us: float,
@@ -110,14 +118,14 @@ class LawShotParameters:
     def __post_init__(self):
         law = get_law(self.model)
         code_parameters(law, self.values)
+        check_fields(self, {"velocity_m_s": "impact_velocity_m_s"})
         if law.shear_modulus is not None and self.shear_modulus_GPa is not None:
             raise InputError(f"{law.name}: shear_modulus_GPa given, but the law computes G(P, T) itself "
                              f"(G0_GPa is its parameter)")
-        if law.shear_modulus is None and not (self.shear_modulus_GPa is not None
-                                              and math.isfinite(self.shear_modulus_GPa)
-                                              and self.shear_modulus_GPa > 0):
+        if law.shear_modulus is None and self.shear_modulus_GPa is None:
             raise InputError(f"{law.name}: shear_modulus_GPa must be a positive number (the law has no G law); "
-                             f"got {self.shear_modulus_GPa}")
+                             "it is not given")
+        check_fields(self, {"shear_modulus_GPa": "positive"})
 
     def law_parameters(self):
         """The law's named tuple in code units (Mbar, K, 1/us, g/cc)."""

@@ -10,14 +10,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
+from shockcal.hydro.rules import check_fields, plate_problem
 from shockcal.hydro.state import InitialState, Material, Numerics
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 
 @dataclass(frozen=True)
 class Geometry:
-    """A symmetric plate impact.
+    """A symmetric plate impact; checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
 
     Args:
         flyer_mm: flyer plate thickness (mm), at the shot's initial temperature (the hot thickness of a
@@ -34,10 +36,15 @@ class Geometry:
     end_us: float
     initial_temperature_K: float | None = None
 
+    def __post_init__(self):
+        check_fields(self, {"flyer_mm": "positive", "target_mm": "positive", "end_us": "positive",
+                            "initial_temperature_K": "positive"})
+
 
 @dataclass(frozen=True)
 class MaterialProperties:
-    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target.
+    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target;
+    checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
 
     Args:
         rho0_g_cc: initial density (g/cc).
@@ -59,6 +66,10 @@ class MaterialProperties:
     cv_J_per_kg_K: float
     strain_rate_ref_per_s: float = 1.0
 
+    def __post_init__(self):
+        check_fields(self, {"rho0_g_cc": "positive", "c1_Mbar": "positive", "c2_Mbar": "finite", "c3_Mbar": "finite",
+                            "gamma0": "nonnegative", "T_ref_K": "positive", "T_melt_K": "positive",
+                            "cv_J_per_kg_K": "positive", "strain_rate_ref_per_s": "positive"})
 
     def code_units(self) -> Material:
         return Material(self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0, self.T_ref_K,
@@ -98,7 +109,7 @@ AL5083 = MaterialProperties(rho0_g_cc=2.668, c1_Mbar=0.7797, c2_Mbar=0.2239, c3_
 @dataclass(frozen=True)
 class HydroSettings:
     """Mesh, output sampling, artificial viscosity and time stepping; the defaults are the study config's
-    (docs/hydro.md measures them).
+    (docs/hydro.md measures them). Checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
 
     Args:
         cell_size_um: Lagrangian cell size (um).
@@ -117,13 +128,21 @@ class HydroSettings:
     q_linear: float = 0.1
     q_quadratic: float = 1.0
 
+    def __post_init__(self):
+        check_fields(self, {"cell_size_um": "positive", "output_dt_ns": "positive", "cfl": "courant",
+                            "dt_initial_us": "positive", "dt_max_us": "positive", "q_linear": "nonnegative",
+                            "q_quadratic": "nonnegative"})
 
     def numerics(self) -> Numerics:
         return Numerics(self.q_linear, self.q_quadratic, self.cfl, self.dt_initial_us, self.dt_max_us)
 
-    def cells(self, thickness_mm: float) -> int:
-        """Cells across a plate (at least one)."""
-        return max(int(round(thickness_mm * MM_TO_CM / (self.cell_size_um * UM_TO_CM))), 1)
+    def cells(self, thickness_mm: float, plate: str = "plate") -> int:
+        """Cells across a plate of `thickness_mm` (mm); an InputError naming `plate` when it is thinner than
+        one cell (`shockcal.hydro.rules.plate_problem`)."""
+        problem = plate_problem(thickness_mm, self.cell_size_um)
+        if problem:
+            raise InputError(f"{plate}: {problem}")
+        return int(round(thickness_mm * MM_TO_CM / (self.cell_size_um * UM_TO_CM)))
 
     def output_dt_us(self) -> float:
         return self.output_dt_ns * NS_TO_US

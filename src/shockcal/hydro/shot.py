@@ -67,7 +67,7 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         the impact's kinetic energy, the plates' initial internal energy left out). A numerical failure is
         a result with status "failed" and a reason naming the cell and time, never an exception.
     """
-    nf, nt = settings.cells(geometry.flyer_mm), settings.cells(geometry.target_mm)
+    nf, nt = settings.cells(geometry.flyer_mm, "Geometry.flyer_mm"), settings.cells(geometry.target_mm, "Geometry.target_mm")
     dt_out = settings.output_dt_us()
     t_out = np.arange(int(round(geometry.end_us / dt_out)) + 1) * dt_out
     velocity, strength = kernel_strength(params, material)

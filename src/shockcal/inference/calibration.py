@@ -25,7 +25,9 @@ class CalibrationSettings:
         sampler: the nested sampler's settings.
         sd_fraction: observation sd as a fraction of each measured feature (0.01: 1%).
         check_units: whether to check that the measurements look like m/s and us (`shockcal.plausibility`).
-        units: each parameter's unit, for the summary.
+        units: each parameter's unit (native: the prior box's and the draws'), for the summary.
+        user_units: each parameter's unit in the summary and the InferenceData, where it differs from
+            `units` (e.g. {"A": "MPa", "G1": "GPa", "V1": "m/s"}; `shockcal.units.user_unit`).
         bounds: the prior box by input (native units), or None for the emulator's box; it must lie
             inside the emulator's (`shockcal.inference.problem.prior_box`).
         velocity_boxes: shot -> its impact-velocity box (m/s), against which each shot's measured
@@ -37,6 +39,7 @@ class CalibrationSettings:
     sd_fraction: float = 0.01
     check_units: bool = True
     units: Mapping[str, str] = field(default_factory=dict)
+    user_units: Mapping[str, str] = field(default_factory=dict)
     bounds: Mapping[str, tuple[float, float]] | None = None
     velocity_boxes: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     check_plateau: bool = True
@@ -70,6 +73,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     posterior = sample(problem, settings.sampler, other_powers="ignore")
     units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
     posterior.units = units
-    posterior.context.update(shots=list(shots), parameters=problem.names, units=units,
+    posterior.user_units = {k: settings.user_units.get(k, unit) for k, unit in units.items()}
+    posterior.context.update(shots=list(shots), parameters=problem.names, units=units, user_units=posterior.user_units,
                              observed=problem.observed.tolist(), observed_sd_m_s=problem.obs_sd.tolist())
     return posterior

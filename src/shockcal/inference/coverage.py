@@ -82,7 +82,7 @@ def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rn
     observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
     trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
     posterior = calibrate(emulator, shots, observed, trial_settings, source=f"synthetic trial {trial}")
-    draws_table, summary = posterior.draws, posterior.summary().set_index("parameter")
+    draws_table, summary = posterior.draws, posterior.summary(native=True).set_index("parameter")
     if draws is not None:
         draws.append(draws_table.assign(trial=trial, run=run))
     problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)

@@ -2,16 +2,23 @@
 
 `posterior_inference_data` takes plain tables and mappings (no study config) and returns the groups:
 
-- `posterior`: the equal-weight draws, one chain: every calibrated input (native units, `units`
-  attribute) and lambda_y; coordinate `row`: the draw's row in the Parquet table;
+- `posterior`: the equal-weight draws, one chain: every calibrated input in the unit a user reads, that
+  unit in its name and its `units` attribute (`A_MPa`, `B_MPa`, `G1_GPa`, `Delta2_GPa`, `V1_m_s`; C, n,
+  m dimensionless), and lambda_y; coordinate `row`: the draw's row in the Parquet table;
 - `sample_stats`: `log_likelihood` of each draw (constants included);
 - `observed_data`: the measured calibration features per shot (m/s), dims (`shot`,);
 - `constant_data`: their sd (`<feature>_sd`, m/s) and the prior box `prior_lower`, `prior_upper` per
-  `input`, with its `unit` (a coordinate, and all units as the JSON attribute `units`);
+  `input` (the posterior's names and units), with its `unit` (a coordinate, and all units as the JSON
+  attribute `units`);
 - `posterior_predictive`, where given: the features of hydrocode runs at posterior draws (m/s), dims
   (chain, draw, shot), coordinate `run`;
-- `weighted_posterior`: the sampler's weighted draws (the exact result): the parameters, `log_weight`
-  (normalised, logsumexp = 0) and `log_likelihood`, dim `weighted_draw`.
+- `weighted_posterior`: the sampler's weighted draws (the exact result): the parameters (as in
+  `posterior`), `log_weight` (normalised, logsumexp = 0) and `log_likelihood`, dim `weighted_draw`.
+
+The unit goes in the variable's name because `az.summary` and ArviZ's plots show names, not
+attributes: a row reads `A_MPa  352.1  42.3 ...` (MPa, GPa and m/s put every value of the paper's
+Table V at 3 significant figures or more, where its Mbar and cm/us read 0.004 and 0.000 at
+`az.summary`'s 3 decimals). The Parquet tables keep the native units the design and the emulator use.
 
 `weighted_posterior` is not one of ArviZ's standard groups; arviz 0.23.4 stores and reads it back
 without a warning (`InferenceData(warn_on_custom_groups=False)`, its default), and ArviZ's functions
@@ -40,6 +47,7 @@ import pandas as pd
 
 from shockcal.errors import InputError
 from shockcal.io import atomic_path
+from shockcal.units import user_columns
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 WEIGHTED_GROUP = "weighted_posterior"
@@ -72,6 +80,7 @@ def _attribute(value):
 
 
 def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Mapping[str, str],
+                             user_units: Mapping[str, str] | None = None,
                              lower: Mapping[str, float], upper: Mapping[str, float],
                              observed: pd.DataFrame, observed_sd: pd.DataFrame,
                              weighted: pd.DataFrame | None = None,
@@ -82,8 +91,11 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
     Args:
         draws: equal-weight draws: a column per name in `names` and `log_likelihood`.
         names: the parameters: the calibrated inputs (native units), then lambda_y (-).
-        units: unit of each name (e.g. "Mbar", "cm/us", "-").
-        lower, upper: the prior box of each calibrated input (its unit).
+        units: unit of each name in `draws` (e.g. "Mbar", "cm/us", "-").
+        user_units: unit of each name in the file, where it differs from `units` (e.g. {"A": "MPa",
+            "G1": "GPa", "V1": "m/s"}; `shockcal.units.user_unit`); the variable is named with it
+            (`shockcal.units.unit_name`). None: the units of `units`, names with their units.
+        lower, upper: the prior box of each calibrated input (its unit in `units`).
         observed: measured features, m/s: one row per shot (index: shot), one column per feature.
         observed_sd: their sd (m/s), the same shape.
         weighted: the sampler's weighted draws (the names, `log_weight`, `log_likelihood`), or None.
@@ -112,23 +124,28 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
     n = len(draws)
     order = np.random.default_rng(0).permutation(n)      # see the module docstring: not a Markov chain
     draws = draws.iloc[order]
+    columns = user_columns({name: units.get(name, "-") for name in names}, user_units or {})
 
-    def unit_attrs(name):
-        return {"units": units.get(name, "-")}
+    def variables(table, dims):
+        """The parameters as variables along `dims` (one chain first, if any), keyed by their names with
+        the user unit, in it."""
+        shape = (1, -1) if dims[0] == "chain" else (-1,)
+        return {columns[name][0]: (dims, table[name].to_numpy(float).reshape(shape) * columns[name][2],
+                                   {"units": columns[name][1]}) for name in names}
 
-    posterior = xr.Dataset(
-        {name: (("chain", "draw"), draws[name].to_numpy(float)[None, :], unit_attrs(name)) for name in names},
-        coords={"chain": [0], "draw": np.arange(n), "row": (("draw",), order)}, attrs=attrs)
+    posterior = xr.Dataset(variables(draws, ("chain", "draw")),
+                           coords={"chain": [0], "draw": np.arange(n), "row": (("draw",), order)}, attrs=attrs)
     sample_stats = xr.Dataset({"log_likelihood": (("chain", "draw"), draws["log_likelihood"].to_numpy(float)[None, :])},
                               coords={"chain": [0], "draw": np.arange(n)})
     observed_data = xr.Dataset({f: (("shot",), observed[f].to_numpy(float), {"units": "m/s"}) for f in features},
                                coords={"shot": shots})
     constant = {f"{f}_sd": (("shot",), observed_sd[f].to_numpy(float), {"units": "m/s"}) for f in features}
-    constant["prior_lower"] = (("input",), np.array([lower[k] for k in inputs], float))
-    constant["prior_upper"] = (("input",), np.array([upper[k] for k in inputs], float))
-    constant_data = xr.Dataset(constant, coords={"shot": shots, "input": inputs,
-                                                 "unit": (("input",), [units.get(k, "-") for k in inputs])},
-                               attrs={"units": _attribute({k: units.get(k, "-") for k in inputs})})
+    factors = np.array([columns[k][2] for k in inputs])
+    constant["prior_lower"] = (("input",), np.array([lower[k] for k in inputs], float) * factors)
+    constant["prior_upper"] = (("input",), np.array([upper[k] for k in inputs], float) * factors)
+    constant_data = xr.Dataset(constant, coords={"shot": shots, "input": [columns[k][0] for k in inputs],
+                                                 "unit": (("input",), [columns[k][1] for k in inputs])},
+                               attrs={"units": _attribute({columns[k][0]: columns[k][1] for k in inputs})})
     groups = {"posterior": posterior, "sample_stats": sample_stats, "observed_data": observed_data,
               "constant_data": constant_data}
     if predictive:
@@ -138,8 +155,8 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
         if missing:
             raise InputError(f"weighted posterior draws: columns {missing} missing")
         groups[WEIGHTED_GROUP] = xr.Dataset(
-            {c: (("weighted_draw",), weighted[c].to_numpy(float), unit_attrs(c) if c in names else {})
-             for c in [*names, "log_weight", "log_likelihood"]},
+            {**variables(weighted, ("weighted_draw",)),
+             **{c: (("weighted_draw",), weighted[c].to_numpy(float)) for c in ("log_weight", "log_likelihood")}},
             coords={"weighted_draw": np.arange(len(weighted))},
             attrs={"about": "the sampler's weighted draws (the exact result); log_weight normalised, logsumexp = 0"})
     return az.InferenceData(attrs=attrs, **groups)

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from shockcal.errors import InputError
+from shockcal.errors import InputError, shown
 from shockcal.io import require_columns
 from shockcal.plausibility import outside_box
 
@@ -45,7 +45,7 @@ def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, see
         bad = ~np.isfinite(values)
         if bad.any():
             row = int(np.argmax(bad))
-            raise InputError(f"{source}: row {row}: {name} = {posterior[name].iloc[row]!r} is not a finite number")
+            raise InputError(f"{source}: row {row}: {name} = {shown(posterior[name].iloc[row])} is not a finite number")
         if bounds is not None and name in bounds:
             low, high = bounds[name]
             outside = outside_box(values, low, high)

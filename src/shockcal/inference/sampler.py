@@ -31,6 +31,7 @@ from shockcal.errors import SamplerError
 from shockcal.inference.summaries import summarize
 from shockcal.progress import Every
 from shockcal.seeds import stream_seed
+from shockcal.units import user_columns
 
 log = logging.getLogger("shockcal.inference.sampler")
 
@@ -207,10 +208,12 @@ class Posterior:
     """A sampled posterior: the sampler's weighted draws (the exact result), an equal-weight resample,
     the log evidence with its uncertainty and the sampler's counts.
 
-    `names` are the parameters: the calibrated inputs (native units), then lambda_y. `draws` has one
-    row per equal-weight draw (the parameters and `log_likelihood`); `weighted_table()` the weighted
-    draws with their log weights; `summary()` the weighted mean, sd and quantiles with their Monte
-    Carlo errors; `info()` everything else (evidence, counts, settings) as a plain dict.
+    `names` are the parameters: the calibrated inputs (native units: `units`, e.g. the paper's Mbar and
+    cm/us), then lambda_y. `draws` has one row per equal-weight draw (the parameters and
+    `log_likelihood`, native units); `weighted_table()` the weighted draws with their log weights
+    (native units); `summary()` the weighted mean, sd and quantiles with their Monte Carlo errors, in
+    `user_units` (name -> the unit a user reads, e.g. {"A": "MPa", "G1": "GPa", "V1": "m/s"};
+    `shockcal.units.user_unit`); `info()` everything else (evidence, counts, settings) as a plain dict.
     """
 
     names: list[str]
@@ -220,6 +223,7 @@ class Posterior:
     cube_power: dict
     distinct_draws: int
     units: dict = field(default_factory=dict)
+    user_units: dict = field(default_factory=dict)
     context: dict = field(default_factory=dict)    # what the caller adds to info() (shots, measured features)
 
     @property
@@ -237,12 +241,23 @@ class Posterior:
         n = len(self.weighted.log_weight)
         return float(np.sqrt(max(1.0 / self.weighted.kish_ess() - 1.0 / n, 0.0)))
 
-    def summary(self) -> pd.DataFrame:
+    def summary(self, native: bool = False) -> pd.DataFrame:
         """Per parameter: weighted mean, sd, 5/50/95% quantiles with their Monte Carlo standard errors,
-        the Kish ESS, and the unit where known."""
+        the Kish ESS, and the unit where known. The values are in the user units (`user_units`), the
+        unit in the parameter's name (`A_MPa`, `G1_GPa`, `V1_m_s`; C, n, m, lambda_y as they are) and in
+        the `unit` column; `native`: in the parameters' own units and names (`units`), as sampled."""
         table = summarize(self.weighted, self.names)
-        if self.units:
+        if not self.units:
+            return table
+        if native:
             table.insert(1, "unit", table["parameter"].map(self.units))
+            return table
+        columns = user_columns(self.units, self.user_units)
+        factor = table["parameter"].map(lambda name: columns[name][2] if name in columns else 1.0)
+        scaled = [c for c in table.columns if c not in ("parameter", "ess")]
+        table[scaled] = table[scaled].mul(factor, axis=0)
+        table.insert(1, "unit", table["parameter"].map(lambda name: columns[name][1] if name in columns else "-"))
+        table["parameter"] = table["parameter"].map(lambda name: columns[name][0] if name in columns else name)
         return table
 
     def weighted_table(self) -> pd.DataFrame:

@@ -1,8 +1,10 @@
 """Posterior figures: 7 (marginals per calibration, rows, with Gray et al.'s sets) and 8 (joint pairs).
 
-Posterior tables hold one column per calibrated input in Table IV units (plus bookkeeping columns
-such as lambda_y and log_likelihood, which are ignored). Axes span the prior box in display units,
-widened where a reference value lies outside it.
+Posterior tables hold one column per calibrated input in its declared unit, the config's
+`inputs.<name>.unit` (Table IV units for Johnson-Cook; plus bookkeeping columns such as lambda_y and
+log_likelihood, which are ignored). Each is drawn in the unit a user reads (`display_columns`: MPa for
+stresses, GPa for the shots' shear-modulus inputs, m/s for velocities). Axes span the prior box in
+those units, widened where a reference value lies outside it.
 """
 
 from __future__ import annotations
@@ -11,7 +13,8 @@ import numpy as np
 import pandas as pd
 
 from shockcal.hydro import JOHNSON_COOK_INPUTS
-from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots, to_display
+from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots
+from shockcal.units import user_columns, user_units
 
 # Gray et al. Johnson-Cook fits for Al-5083 (SPEC section 3), display units (A, B in MPa).
 GRAY_SETS = {
@@ -30,10 +33,28 @@ def _gray_sets(config: dict) -> dict:
     return GRAY_SETS if set(JOHNSON_COOK_INPUTS) <= set(config["inputs"]) else {}
 
 
+def display_columns(config: dict) -> dict[str, tuple[str, str, float]]:
+    """Each input -> (its name with the unit, its display unit, the factor from its declared unit):
+    `shockcal.units.user_columns`, the shots' `shear_modulus_inputs` read as moduli."""
+    moduli = {name for shot in config["shots"].values() for name in shot["shear_modulus_inputs"]}
+    units = {name: box["unit"] for name, box in config["inputs"].items()}
+    return user_columns(units, user_units(units, moduli))
+
+
+def to_display(name: str, values, config: dict):
+    """Values of input `name` converted from its declared unit to its display unit."""
+    return np.asarray(values, dtype=float) * display_columns(config)[name][2]
+
+
+def display_label(name: str, config: dict) -> str:
+    """Axis label of input `name` with its display unit."""
+    return input_label(name, display_columns(config)[name][1])
+
+
 def display_limits(name: str, config: dict) -> tuple[float, float]:
     """Prior box of input `name` in display units, widened to show any of Gray's values outside it."""
     box = config["inputs"][name]
-    lo, hi = to_display(name, [box["min"], box["max"]])
+    lo, hi = to_display(name, [box["min"], box["max"]], config)
     refs = [s[name] for s in _gray_sets(config).values() if name in s]
     lo, hi = min([lo, *refs]), max([hi, *refs])
     pad = 0.02 * (hi - lo)
@@ -43,7 +64,7 @@ def display_limits(name: str, config: dict) -> tuple[float, float]:
 def _shade_outside_box(ax, name: str, config: dict) -> None:
     """Grey shading over the parts of the axis outside the prior box."""
     box = config["inputs"][name]
-    lo, hi = to_display(name, [box["min"], box["max"]])
+    lo, hi = to_display(name, [box["min"], box["max"]], config)
     left, right = display_limits(name, config)
     ax.axvspan(left, lo, color=COLORS["prior"], lw=0)
     ax.axvspan(hi, right, color=COLORS["prior"], lw=0)
@@ -76,7 +97,7 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
                 ax.text(0.5, 0.5, f"not an input\nof {calib}", transform=ax.transAxes, ha="center",
                         va="center", fontsize=7, color="0.5")
             else:
-                values = to_display(name, samples[name])
+                values = to_display(name, samples[name], config)
                 ax.hist(values, bins=N_BINS, range=display_limits(name, config), density=True,
                         color=COLORS["posterior"], alpha=0.75, lw=0)
                 ax.set_xlim(display_limits(name, config))
@@ -84,7 +105,7 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
                 _shade_outside_box(ax, name, config)
                 _gray_lines(ax, name, config)
             if r == len(rows) - 1:
-                ax.set_xlabel(input_label(name))
+                ax.set_xlabel(display_label(name, config))
             ax.tick_params(axis="x", labelsize=6.5)
         axes[r, 0].set_ylabel(calib, fontsize=10, fontweight="bold")
     figure_legend(fig, axes, title="posterior (blue); grey: outside the prior box")
@@ -114,7 +135,7 @@ def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
         no_data(axes[k // 2, k // 2], "joint posterior missing or empty")
         return fig
     missing = [n for n in names if n not in samples.columns]
-    values = {n: to_display(n, samples[n]) for n in names if n not in missing}
+    values = {n: to_display(n, samples[n], config) for n in names if n not in missing}
     limits = {n: display_limits(n, config) for n in names}
     for i, yname in enumerate(names):
         for j, xname in enumerate(names):
@@ -143,11 +164,11 @@ def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
             ax.set_xlim(limits[xname])
             ax.tick_params(labelsize=6)
             if i == k - 1:
-                ax.set_xlabel(input_label(xname), fontsize=7.5)
+                ax.set_xlabel(display_label(xname, config), fontsize=7.5)
             else:
                 ax.set_xticklabels([])
             if j == 0 and i > 0:
-                ax.set_ylabel(input_label(yname), fontsize=7.5)
+                ax.set_ylabel(display_label(yname, config), fontsize=7.5)
             elif i != j:
                 ax.set_yticklabels([])
     fig.suptitle(f"Joint posterior, {len(samples):,} samples: densities (diagonal), 50% and 90% regions")

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from shockcal.plots.style import CALIBRATION_FEATURES, input_label, no_data, styled, subplots
+from shockcal.plots.style import CALIBRATION_FEATURES, input_symbol, no_data, styled, subplots
 
 DOMAIN_TITLES = {"prior": "prior box", "posterior_q05_q95": "joint posterior's 5-95% box"}
 
@@ -42,7 +42,7 @@ def sobol_indices(table: pd.DataFrame | None, shots: list[str]):
                     st, s1 = total.iat[i, j], first.iat[i, j]
                     ax.text(j, i, f"{st:.2f}\n({s1:.2f})", ha="center", va="center", fontsize=6,
                             color="white" if st > 0.6 else "black")
-            ax.set_xticks(range(len(inputs)), [input_label(k).split(" (")[0] for k in inputs])
+            ax.set_xticks(range(len(inputs)), [input_symbol(k) for k in inputs])
             ax.set_yticks(range(len(features)), features if c == 0 else [""] * len(features))
             ax.set_title(f"{shot}: {DOMAIN_TITLES.get(domain, domain)}")
             ax.spines[:].set_visible(False)

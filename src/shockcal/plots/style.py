@@ -6,8 +6,8 @@ or toy model, green for reference values (Gray et al.'s Johnson-Cook sets); purp
 for the early and late mixture components of the feature extractor.
 
 Display units (what a shock physicist reads): A and B in MPa, shear moduli in GPa, impact
-velocities in m/s, times in microseconds, velocities in m/s. Tables keep the paper's Table IV units
-(Mbar, cm/us); `to_display` converts.
+velocities in m/s, times in microseconds, velocities in m/s; the posterior tables keep the paper's
+Table IV units (Mbar, cm/us), and the posterior figures convert them (`shockcal.units.user_columns`).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 from shockcal.io import atomic_path  # noqa: E402
+from shockcal.units import DIMENSIONLESS  # noqa: E402
 
 COLORS = {
     "training": "#8c8c8c",
@@ -47,23 +48,8 @@ RC = {
     "axes.spines.right": False,
 }
 
-# name -> (axis label, factor from the table's Table IV unit to the display unit)
-_STRESS_MPA = 1.0e5     # Mbar -> MPa
-_STRESS_GPA = 100.0     # Mbar -> GPa
-_SPEED_M_S = 1.0e4      # cm/us -> m/s
-INPUT_DISPLAY = {
-    "A": ("A (MPa)", _STRESS_MPA),
-    "B": ("B (MPa)", _STRESS_MPA),
-    "C": ("C", 1.0),
-    "n": ("n", 1.0),
-    "m": ("m", 1.0),
-    "V1": ("V1 (m/s)", _SPEED_M_S),
-    "V2": ("V2 (m/s)", _SPEED_M_S),
-    "V3": ("V3 (m/s)", _SPEED_M_S),
-    "G1": ("G1 (GPa)", _STRESS_GPA),
-    "Delta2": ("Δ2 (GPa)", _STRESS_GPA),
-    "Delta3": ("Δ3 (GPa)", _STRESS_GPA),
-}
+# how an input's name is drawn, where it is not its name
+SYMBOLS = {"Delta2": "Δ2", "Delta3": "Δ3"}
 
 # The five features of a trace (SPEC section 4), in plotting order, and the four used in calibration.
 FEATURES = {
@@ -79,14 +65,14 @@ VELOCITY_LABEL = "free-surface velocity (m/s)"
 TIME_LABEL = "time (µs)"
 
 
-def input_label(name: str) -> str:
-    """Axis label with display unit for a calibration input (unknown names are shown as they are)."""
-    return INPUT_DISPLAY.get(name, (name, 1.0))[0]
+def input_symbol(name: str) -> str:
+    """How a calibration input is drawn: Delta2 as Δ2, the others by name."""
+    return SYMBOLS.get(name, name)
 
 
-def to_display(name: str, values):
-    """Values of input `name` converted from Table IV units to display units."""
-    return np.asarray(values, dtype=float) * INPUT_DISPLAY.get(name, (name, 1.0))[1]
+def input_label(name: str, unit: str = "-") -> str:
+    """Axis label of a calibration input in `unit` (its display unit): 'A (MPa)', 'Δ2 (GPa)'; 'C'."""
+    return input_symbol(name) if unit in DIMENSIONLESS else f"{input_symbol(name)} ({unit})"
 
 
 def feature_label(column: str) -> str:

@@ -7,7 +7,8 @@ Layers, each importing only those above it and the library:
 - `validate`: reading a config file, its schema and the rules across keys, the design file's check;
 - `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands;
 - `next_shot_check`: the next-shot check's candidates as fourth shots of derived configs;
-- `workflow`, `stage_times`: the Snakefile's helpers and the per-stage cost table from its benchmark files.
+- `workflow`, `stage_times`: the Snakefile's helpers and the per-stage cost table from its benchmark files;
+- `snakemake_console`: snakemake's console at one progress line (`snakemake --logger shockcal`, what `make` runs).
 
 The library (hydro, simulators, design, velocimetry, emulator, inference, campaign) never imports this package: the
 `shockcal` commands call an adapter, and the adapter hands the library typed settings.

@@ -16,7 +16,15 @@ from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_h
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
 from shockcal.seeds import stream_seed
-from shockcal.study.config import candidate_config, end_time_us, prior_bounds, shot_config, velocity_box_m_s, wave_sizes
+from shockcal.study.config import (
+    candidate_config,
+    end_time_us,
+    input_user_units,
+    prior_bounds,
+    shot_config,
+    velocity_box_m_s,
+    wave_sizes,
+)
 from shockcal.study.strength import DEFAULT_MODEL, strength_model
 
 if TYPE_CHECKING:
@@ -148,7 +156,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units`, the
     prior box `inputs` and their units, the shots' impact-velocity boxes for the plateau check
     (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), seeded by the shots'
-    "calibration" stream of study.seed (a trial reseeds from its own)."""
+    "calibration" stream of study.seed (a trial reseeds from its own); the summary's user units
+    (`input_user_units`)."""
     from shockcal.inference.calibration import CalibrationSettings
     from shockcal.inference.sampler import SamplerSettings
 
@@ -161,9 +170,10 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
                               replicates=1 if check else config["calibration"]["replicates"])
     boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots if shot in config["shots"]}
     return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
-                               {name: box["unit"] for name, box in config["inputs"].items()}, prior_bounds(config),
-                               {shot: box for shot, box in boxes.items() if box is not None},
-                               config["checks"]["plateau_vs_velocity"])
+                               units={name: box["unit"] for name, box in config["inputs"].items()},
+                               user_units=input_user_units(config), bounds=prior_bounds(config),
+                               velocity_boxes={shot: box for shot, box in boxes.items() if box is not None},
+                               check_plateau=config["checks"]["plateau_vs_velocity"])
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False

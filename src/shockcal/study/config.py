@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from shockcal.errors import ConfigError
-from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S
+from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S, user_columns, user_units
 
 AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
 
@@ -41,6 +41,20 @@ def input_names(config: dict) -> list[str]:
 def prior_bounds(config: dict) -> dict[str, tuple[float, float]]:
     """The prior box, input by input in config order: name -> (min, max) in the box's native units."""
     return {name: (box["min"], box["max"]) for name, box in config["inputs"].items()}
+
+
+def input_user_units(config: dict) -> dict[str, str]:
+    """Each input's unit for a user (`shockcal.units.user_unit` of its declared `unit`): a shear-modulus
+    input (a shot's `shear_modulus_inputs`) in Mbar reads in GPa, another pressure (a stress) in MPa, a
+    velocity in m/s; MPa, GPa, m/s and dimensionless inputs as declared."""
+    moduli = {name for shot in config["shots"].values() for name in shot["shear_modulus_inputs"]}
+    return user_units({name: box["unit"] for name, box in config["inputs"].items()}, moduli)
+
+
+def input_columns(config: dict) -> dict[str, tuple[str, str, float]]:
+    """Each input -> (its name for a user, e.g. A_MPa; its user unit; the factor from its declared unit):
+    `shockcal.units.user_columns` with `input_user_units`."""
+    return user_columns({name: box["unit"] for name, box in config["inputs"].items()}, input_user_units(config))
 
 
 def velocity_box_m_s(config: dict, shot: str) -> tuple[float, float] | None:

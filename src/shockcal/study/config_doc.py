@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from shockcal.errors import ConfigError
+from shockcal.hydro.rules import RULES
 
 DOC_PATH = Path("docs") / "configuration.md"   # relative to the repository root
 
@@ -216,6 +217,8 @@ def _range(s: dict) -> str:
         parts.append(f"{'>=' if low[0] == '[' else '>'} {_value(low[1])}")
     elif high:
         parts.append(f"{'<=' if high[0] == ']' else '<'} {_value(high[1])}")
+    if s.get("x-rule") and RULES[s["x-rule"]].interval():
+        parts.append(RULES[s["x-rule"]].interval())
     if "enum" in s:
         parts.append("one of " + ", ".join(f"`{_value(v)}`" for v in s["enum"]))
     if "enum" in s.get("items", {}):

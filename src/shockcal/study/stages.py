@@ -69,7 +69,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the posterior rows run through the hydrocode for predictions
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
-    "sensitivity": ("study.seed", "sensitivity", "inputs"),
+    "sensitivity": ("study.seed", "sensitivity", "inputs", "shots.*.shear_modulus_inputs"),
     # a next-shot candidate's design: the joint posterior's draws with the new shot's nuisance inputs
     "next_shot_design": ("study.seed", "next_shot.n_draws", *_CANDIDATE_BOX, *_CANDIDATE),
     # a candidate's hydrocode runs and their features

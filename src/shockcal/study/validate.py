@@ -9,12 +9,15 @@ for the workflow is the repository root.
 
 from __future__ import annotations
 
+import difflib
+import os
+from collections.abc import Mapping
 from pathlib import Path
 
 import yaml
 
-from shockcal.errors import ConfigError, InputError, ShockcalError
-from shockcal.hydro import JOHNSON_COOK_INPUTS
+from shockcal.errors import ConfigError, InputError, ShockcalError, number
+from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
@@ -79,12 +82,20 @@ def validate_config(config: dict, source: str = "config") -> dict:
 
 def _schema_validator():
     """A JSON Schema (2020-12) validator of config.schema.yaml that also fills each missing key's
-    `default:` before checking it, as jsonschema's FAQ describes (and snakemake's `validate` does)."""
+    `default:` before checking it, as jsonschema's FAQ describes (and snakemake's `validate` does), and
+    checks `x-rule: <name>` with the hydrocode's own rule of that name (`shockcal.hydro.rules`), so the
+    config and the library refuse the same values in the same words."""
     import copy
 
-    from jsonschema import Draft202012Validator, validators
+    from jsonschema import Draft202012Validator, ValidationError, validators
 
     check_properties = Draft202012Validator.VALIDATORS["properties"]
+
+    def check_rule(validator, rule, instance, schema):
+        if validator.is_type(instance, "number"):
+            problem = rules.problem(instance, rule)
+            if problem:
+                yield ValidationError(problem)
 
     def fill_defaults(validator, properties, instance, schema):
         if isinstance(instance, dict):
@@ -94,38 +105,111 @@ def _schema_validator():
         yield from check_properties(validator, properties, instance, schema)
 
     schema = yaml.safe_load(SCHEMA_PATH.read_text())
-    return validators.extend(Draft202012Validator, {"properties": fill_defaults})(schema)
+    return validators.extend(Draft202012Validator, {"properties": fill_defaults, "x-rule": check_rule})(schema)
 
 
-def validate_or_exit(config: dict, source: str = "config") -> dict:
+def validate_or_exit(config: dict, files: list[str] | None = None, overrides: dict | None = None) -> dict:
     """`validate_config` for the Snakefile: a bad config or design ends snakemake with the message alone
-    (SystemExit), where an exception would print a traceback around it."""
+    (SystemExit), where an exception would print a traceback around it. `files` are the config files
+    merged into `config`, later ones overriding (the `configfile:` and then snakemake's --configfile
+    overlays), `overrides` snakemake's --config values, which override them all; the message names the
+    one that sets the key at fault (`config_source_of`)."""
     try:
-        return validate_config(config, source)
+        return validate_config(config, CONFIG_SOURCE)
+    except ConfigError as exc:
+        raise SystemExit(f"shockcal: error: {_name_source(str(exc), files or [], overrides or {})}") from None
     except ShockcalError as exc:
         raise SystemExit(f"shockcal: error: {exc}") from None
 
 
+CONFIG_SOURCE = "config"     # what a merged config's messages start with, before `_name_source` names the file
+
+
+def _name_source(message: str, files: list[str], overrides: dict) -> str:
+    """A message 'config: key.path: reason' with 'config' replaced by the file that sets key.path."""
+    prefix = f"{CONFIG_SOURCE}: "
+    if not message.startswith(prefix) or not files:
+        return message
+    key = message[len(prefix):].split(": ", 1)[0]
+    return config_source_of(key, files, overrides) + message[len(CONFIG_SOURCE):]
+
+
+def config_source_of(key: str, files: list[str], overrides: dict | None = None) -> str:
+    """Which source of a merged config sets the dotted `key` (`a.b[0]` reads as `a.b`): among `files`
+    (later ones overriding) and then snakemake's --config `overrides`, the one that holds the longest part
+    of its path, the later on a tie; when none holds any of it (a default), all the files joined by ' + '."""
+    parts = key.split("[")[0].split(".")
+    sources = [(_shown(path), lambda path=path: yaml.safe_load(Path(path).read_text(encoding="utf-8-sig")))
+               for path in files]
+    sources.append(("snakemake --config", lambda: overrides))
+    best, depth = " + ".join(map(_shown, files)), 0
+    for name, load in sources:
+        try:
+            node = load()
+        except (OSError, yaml.YAMLError, UnicodeDecodeError):
+            continue
+        held = 0
+        for part in parts:
+            match = [v for k, v in node.items() if str(k) == part] if isinstance(node, Mapping) else []
+            if not match:
+                break
+            node, held = match[0], held + 1
+        if held and held >= depth:
+            best, depth = name, held
+    return best
+
+
+def _shown(path: str) -> str:
+    """`path` relative to the working directory when it lies inside it (snakemake makes overlays absolute)."""
+    relative = os.path.relpath(path)
+    return path if relative.startswith("..") else relative
+
+
 def _normalise_shot_names(config: dict) -> None:
-    """YAML reads an unquoted shot name like 104 as an int; shot names are strings."""
-    for section in (config.get("shots"), (config.get("observed") or {}).get("features"),
-                    (config.get("observed") or {}).get("records")):
-        if isinstance(section, dict):
-            for key in [k for k in section if not isinstance(k, str)]:
-                section[str(key)] = section.pop(key)
-    base_shots = (config.get("design") or {}).get("base_shots")
-    if isinstance(base_shots, list):
-        config["design"]["base_shots"] = [str(shot) for shot in base_shots]
-    next_shot = config.get("next_shot") or {}
-    for spec in [*(next_shot.get("candidates") or {}).values(), next_shot.get("grid")]:
+    """YAML reads an unquoted shot name like 104 as an int; shot names are strings. It runs before the
+    schema check, so it assumes no shape: a section of the wrong type is left for the schema to name."""
+    observed = _section(config, "observed")
+    for section in (_section(config, "shots"), _section(observed, "features"), _section(observed, "records")):
+        for key in [k for k in section if not isinstance(k, str)]:
+            section[str(key)] = section.pop(key)
+    design = _section(config, "design")
+    if isinstance(design.get("base_shots"), list):
+        design["base_shots"] = [str(shot) if isinstance(shot, int) else shot for shot in design["base_shots"]]
+    next_shot = _section(config, "next_shot")
+    for spec in [*_section(next_shot, "candidates").values(), next_shot.get("grid")]:
         if isinstance(spec, dict) and isinstance(spec.get("shot"), int):     # a candidate's reference shot
             spec["shot"] = str(spec["shot"])
 
 
+def _section(mapping: dict, key: str) -> dict:
+    """`mapping[key]` when both are mappings, else an empty one (a shape the schema check will name)."""
+    section = mapping.get(key) if isinstance(mapping, dict) else None
+    return section if isinstance(section, dict) else {}
+
+
 def _schema_message(exc) -> str:
-    """Turn a jsonschema error into 'key.path: reason'."""
+    """Turn a jsonschema error into 'key.path: reason': an unknown key with the known keys closest to it
+    ("did you mean"), a value matching none of a key's alternatives with each alternative's reason."""
     key = ".".join(str(p) for p in exc.absolute_path) or "<top level>"
-    return f"{key}: {exc.message}"
+    message = exc.message
+    if exc.validator == "additionalProperties" and isinstance(exc.instance, dict) and "properties" in exc.schema:
+        known = list(exc.schema["properties"])
+        close = {k: difflib.get_close_matches(str(k), known, n=1) for k in exc.instance if k not in known}
+        message += "".join(f"; did you mean '{match[0]}' for '{k}'?" if len(close) > 1 else
+                           f"; did you mean '{match[0]}'?" for k, match in close.items() if match)
+    elif exc.validator == "oneOf" and exc.context:
+        message = "; or ".join(dict.fromkeys(sub.message for sub in exc.context))
+    elif exc.validator == "type" and isinstance(exc.instance, list | dict):      # the value itself may be long
+        expected = exc.validator_value if isinstance(exc.validator_value, list) else [exc.validator_value]
+        message = (f"{SCHEMA_TYPES[type(exc.instance).__name__]} given, but it must be "
+                   f"{' or '.join(SCHEMA_TYPES.get(t, t) for t in expected)}")
+    return f"{key}: {message}"
+
+
+# JSON Schema's types as a YAML writer sees them (and Python's list and dict)
+SCHEMA_TYPES = {"object": "a mapping (key: value)", "array": "a list", "null": "null", "dict": "a mapping",
+                "list": "a list", "number": "a number", "string": "a string", "integer": "an integer",
+                "boolean": "true or false"}
 
 
 def check_semantics(config: dict, source: str = "config") -> None:
@@ -138,8 +222,9 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for name in JOHNSON_COOK_INPUTS if strength_model(config) == DEFAULT_MODEL else ():
         if name not in inputs:
             raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {JOHNSON_COOK_INPUTS} are required")
-        if inputs[name]["min"] < 0:
-            raise ConfigError(f"{source}: inputs.{name}.min: Johnson-Cook parameters cannot be negative")
+        problem = rules.problem(inputs[name]["min"], "nonnegative")       # ShotParameters' rule
+        if problem:
+            raise ConfigError(f"{source}: inputs.{name}.min: {problem}; Johnson-Cook parameters cannot be negative")
     for shot, spec in config["shots"].items():
         mapped = [("velocity_input", spec["velocity_input"])]
         mapped += [(f"shear_modulus_inputs[{i}]", name) for i, name in enumerate(spec["shear_modulus_inputs"])
@@ -149,6 +234,8 @@ def check_semantics(config: dict, source: str = "config") -> None:
                 raise ConfigError(f"{source}: shots.{shot}.{key}: '{name}' is not one of the inputs {sorted(inputs)}")
     for shot, spec in config["shots"].items():
         check_initial_temperature(spec, config["material"], f"{source}: shots.{shot}.initial_temperature_K")
+        check_plates(spec, config["hydro"]["cell_size_um"], f"{source}: shots.{shot}")
+        check_velocity_box(config, shot, source)
     if config["calibration"]["replicates"] == 2:
         raise ConfigError(f"{source}: calibration.replicates: 2 runs give no usable spread of their quantiles; "
                           "use 1, or 3 or more")
@@ -270,6 +357,7 @@ def check_next_shot(config: dict, source: str = "config") -> None:
         if spec["shot"] not in config["shots"]:
             raise ConfigError(f"{where}.shot: '{spec['shot']}' is not a shot; known shots are {sorted(config['shots'])}")
         check_initial_temperature(spec, config["material"], f"{where}.initial_temperature_K")
+        check_plates(spec, config["hydro"]["cell_size_um"], where)
         box = shear_modulus_box_Mbar(config, spec["shot"])
         if box is None:
             continue
@@ -295,6 +383,27 @@ def check_initial_temperature(spec: dict, material: dict, where: str) -> None:
     if temperature is not None and not temperature < material["T_melt_K"]:
         raise ConfigError(f"{where}: {temperature:g} K is at or above material.T_melt_K ({material['T_melt_K']:g} K); "
                           "a shot starts solid, below the melting temperature")
+
+
+def check_plates(spec: dict, cell_size_um: float, where: str) -> None:
+    """Each plate of a shot or candidate section `spec` at least one cell thick, the hydrocode's own rule
+    (`shockcal.hydro.rules.plate_problem`, which `HydroSettings.cells` applies)."""
+    for plate in ("flyer_mm", "target_mm"):
+        problem = rules.plate_problem(spec[plate], cell_size_um)
+        if problem:
+            raise ConfigError(f"{where}.{plate}: {problem}")
+
+
+def check_velocity_box(config: dict, shot: str, source: str) -> None:
+    """Both ends of `shot`'s impact-velocity box (its `velocity_input`, in a velocity unit shockcal knows)
+    obey the hydrocode's impact-velocity rule (`ShotParameters.velocity_m_s`)."""
+    box = velocity_box_m_s(config, shot)
+    name = config["shots"][shot]["velocity_input"]
+    for end, value_m_s in zip(("min", "max"), box or (), strict=True):
+        problem = rules.problem(value_m_s, "impact_velocity_m_s")
+        if problem:
+            raise ConfigError(f"{source}: inputs.{name}.{end}: {number(config['inputs'][name][end])} "
+                              f"{config['inputs'][name]['unit']}, shot {shot}'s impact velocity in m/s: {problem}")
 
 
 def check_distinct(observed: dict, source: str) -> None:

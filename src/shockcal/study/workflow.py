@@ -14,6 +14,21 @@ def write_if_changed(path, text: str) -> None:
         path.write_text(text)
 
 
+def point_stable_name(effective_config, stable_name: str = "effective.yaml") -> Path:
+    """Make `stable_name`, next to the content-named `effective_config`, a relative symlink to it (replaced
+    atomically) and return the link: the path a user hands `shockcal --config` to reuse a study's settings.
+    The workflow calls this when a run starts jobs (`onstart`), so a dry run with other settings leaves it."""
+    import os
+
+    target = Path(effective_config)
+    link = target.with_name(stable_name)
+    temporary = link.with_name(f".{stable_name}.{os.getpid()}")
+    temporary.unlink(missing_ok=True)
+    temporary.symlink_to(target.name)
+    os.replace(temporary, link)
+    return link
+
+
 def chunk_rows(chunk, chunk_size: int, total: int | None = None) -> str:
     """The slice START:STOP of one chunk (design rows for `shockcal simulate --rows`, trials for
     `shockcal calibrate-check --trial-range`), cut at `total` when given."""

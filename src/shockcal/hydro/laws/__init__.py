@@ -26,7 +26,8 @@ from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 
 MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
 
-__all__ = ["LAWS", "Law", "Param", "code_parameters", "flow_stress_curve", "get_law", "shear_modulus_gpa"]
+__all__ = ["LAWS", "Law", "Param", "code_parameters", "flow_stress_curve", "get_law", "melt_temperature_K",
+           "shear_modulus_gpa"]
 
 
 def get_law(name: str) -> Law:
@@ -81,3 +82,11 @@ def shear_modulus_gpa(law: Law, values: Mapping[str, float], temperature_K: floa
     params = code_parameters(law, values)
     G = law.shear_modulus(params, pressure_GPa / MBAR_TO_GPA, float(temperature_K), float(density_ratio))
     return G * MBAR_TO_GPA
+
+
+def melt_temperature_K(law: Law, values: Mapping[str, float], density_ratio: float = 1.0) -> float | None:
+    """The law's melting temperature (K) at the density ratio rho/rho0, at and above which its flow stress
+    is zero, or None for a law without a melt cut-off (Zerilli-Armstrong)."""
+    if law.melt_temperature is None:
+        return None
+    return float(law.melt_temperature(code_parameters(law, values), float(density_ratio)))

@@ -16,6 +16,7 @@ from shockcal.hydro.laws.preston_tonks_wallace import PrestonTonksWallace, ptw_f
 from shockcal.hydro.laws.steinberg_guinan import (
     SteinbergGuinan,
     steinberg_guinan_flow_stress,
+    steinberg_guinan_melt_temperature,
     steinberg_guinan_shear_modulus,
 )
 from shockcal.hydro.laws.zerilli_armstrong import ZerilliArmstrong, zerilli_armstrong_flow_stress
@@ -58,7 +59,8 @@ def _one(name, meaning, default=None) -> Param:
 class Law:
     """A strength law: its kernels (code units, `flow_stress(law, eps_p, rate, T, P, eta)`; the
     optional `shear_modulus(law, P, T, eta)`), its parameters and the constraints on their values
-    (text, predicate on the user values)."""
+    (text, predicate on the user values); `melt_temperature(law, eta)` (K), where the strength vanishes, for
+    the laws that have one."""
 
     name: str
     title: str
@@ -68,6 +70,7 @@ class Law:
     flow_stress: Callable
     shear_modulus: Callable | None = None
     constraints: tuple[tuple[str, Callable[[Mapping[str, float]], bool]], ...] = ()
+    melt_temperature: Callable | None = None
 
     def param(self, name: str) -> Param:
         return next(p for p in self.params if p.name == name)
@@ -92,6 +95,7 @@ JOHNSON_COOK = Law(
     JohnsonCook, johnson_cook_flow_stress,
     constraints=(("T_melt_K > T_ref_K", lambda v: v["T_melt_K"] > v["T_ref_K"]),
                  ("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0)),
+    melt_temperature=lambda law, eta: law.T_melt,
 )
 
 STEINBERG_GUINAN = Law(
@@ -114,6 +118,7 @@ STEINBERG_GUINAN = Law(
     constraints=(("G0_GPa > 0", lambda v: v["G0_GPa"] > 0),
                  ("Ymax_GPa >= Y0_GPa", lambda v: v["Ymax_GPa"] >= v["Y0_GPa"]),
                  ("beta >= 0 and eps_i >= 0", lambda v: v["beta"] >= 0 and v["eps_i"] >= 0)),
+    melt_temperature=steinberg_guinan_melt_temperature,
 )
 
 PRESTON_TONKS_WALLACE = Law(
@@ -145,6 +150,7 @@ PRESTON_TONKS_WALLACE = Law(
         ("p >= 0, gamma > 0, G0_GPa > 0, M_g_per_mol > 0, rho0_g_per_cc > 0",
          lambda v: min(v["gamma"], v["G0_GPa"], v["M_g_per_mol"], v["rho0_g_per_cc"]) > 0 and v["p"] >= 0),
     ),
+    melt_temperature=lambda law, eta: law.T_melt,
 )
 
 ZERILLI_ARMSTRONG = Law(
