@@ -1,7 +1,7 @@
 """A sequential study's workflow (design.strategy: waves, config/sequential-quick.yaml over config/quick.yaml):
-its DAG per wave count (dry runs), and on one run of the toy study: nothing to redo, a resume after wave 2's
-outputs are lost schedules wave 2 onward only, an extractor change reruns no hydrocode, and a settled
-posterior stops the study with an empty wave."""
+its DAG per wave count (dry runs), and on one run of the toy study: nothing to redo, a study killed in wave 2
+(its outputs from wave 2 on missing) resumes at wave 2, an extractor change reruns no hydrocode of wave 0 and
+re-places the later waves, and a settled posterior stops the study with an empty wave."""
 
 from __future__ import annotations
 
@@ -60,26 +60,25 @@ def test_the_study_uses_every_wave(sequential):
 
 
 @pytest.mark.slow
-def test_a_study_that_lost_wave_2_resumes_at_wave_2(sequential):
+def test_a_study_killed_in_wave_2_resumes_at_wave_2(sequential):
     results, config = sequential
-    for part in ("design.parquet", "simulations", "features"):
-        path = results / "wave2" / part
-        path.unlink() if path.is_file() else shutil.rmtree(path)
+    for path in (results / "wave2", results / "waves" / "step2", results / "emulator"):
+        shutil.rmtree(path)
     jobs = pending_jobs(SEQUENTIAL, config)
     assert jobs["wave_design"] == 1
-    assert {key for key in jobs if key.startswith("simulate")} == {"simulate[wave2]"}
+    assert {key for key in jobs if key.startswith("simulate")} == {"simulate[wave2]", "simulate[predict]"}
     assert "wave_emulator" not in jobs and "wave_calibrate" not in jobs
     snakemake("all", "--cores", "2", config_files=[SEQUENTIAL, config])
     assert pending_jobs(SEQUENTIAL, config) == {}
 
 
 @pytest.mark.slow
-def test_an_extractor_change_reruns_no_hydrocode(sequential, tmp_path):
+def test_an_extractor_change_reruns_no_wave_0_hydrocode_and_re_places_the_later_waves(sequential, tmp_path):
     results, config = sequential
     extractor = overlay(tmp_path / "extractor.yaml", features={"n_samples": 1500})
     jobs = pending_jobs(SEQUENTIAL, config, extractor)
-    assert not [key for key in jobs if key.startswith("simulate") or key == "wave_design"]
-    assert jobs["features_chunk"] == SHOTS * 3 and jobs["features_chunk[wave1]"] == SHOTS
+    assert "simulate" not in jobs and jobs["features_chunk"] == SHOTS * 3          # wave 0: features only
+    assert jobs["wave_design"] == 2 and jobs["simulate[wave1]"] == jobs["simulate[wave2]"] == SHOTS
     assert jobs["wave_emulator"] == jobs["wave_calibrate"] == 2 and jobs["emulator"] == 1
 
 

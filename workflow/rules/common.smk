@@ -133,11 +133,9 @@ def pairs(shots, paths):
 
 def wave_design_inputs(wildcards):
     """Wave k's design reads step k-1's posterior, runs and (max_variance) emulator, wave k-1's design
-    (empty: the study stopped) and step k-2's posterior summary (the stopping rule). All `ancient`: a
-    wave's design, once made, stays (its runs are valid training runs wherever they lie), so a change
-    upstream (the extractor, the emulator or sampler settings) refits and recalibrates on the same runs
-    and reruns no hydrocode; a change of design.waves (params) redesigns. To redesign after another
-    change, delete the waves' designs."""
+    (empty: the study stopped) and step k-2's posterior summary (the stopping rule). Not `ancient`: a
+    change upstream (the extractor, the emulator or sampler settings) moves the posterior and so
+    re-places the later waves, as a fresh study with that config would (docs/sequential.md)."""
     k = int(wildcards.wave)
     inputs = {
         "posterior": rules.wave_calibrate.output.samples.format(step=k - 1),
@@ -149,4 +147,4 @@ def wave_design_inputs(wildcards):
     }
     if k >= 2:
         inputs["earlier"] = rules.wave_calibrate.output.summary.format(step=k - 2)
-    return {name: ancient(path) for name, path in inputs.items()}
+    return inputs
