@@ -35,7 +35,7 @@ def register(subparsers) -> None:
 def run_wave_design(args) -> int:
     import logging
 
-    from shockcal.cli.calibrate import companion_path
+    from shockcal.inference.posterior_files import companion_path
     from shockcal.design.waves import wave_design
     from shockcal.errors import InputError
     from shockcal.inference.summaries import posterior_settled, quantile_shifts
