@@ -35,9 +35,9 @@ def register(subparsers) -> None:
 def run_wave_design(args) -> int:
     import logging
 
-    from shockcal.inference.posterior_files import companion_path
     from shockcal.design.waves import wave_design
     from shockcal.errors import InputError
+    from shockcal.inference.posterior_files import companion_path
     from shockcal.inference.summaries import posterior_settled, quantile_shifts
     from shockcal.io import read_table, write_table
     from shockcal.seeds import stream_seed
