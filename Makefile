@@ -27,7 +27,7 @@ define study
 endef
 
 .DEFAULT_GOAL := help
-.PHONY: help env study quick flag-archive models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: help env study sequential quick flag-archive models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 help:  ## these targets, one line each
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
@@ -42,6 +42,9 @@ $(INSTALLED): pyproject.toml constraints.txt
 
 study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report into results
 	$(call study,results,all)
+
+sequential: $(INSTALLED)  ## the study in waves placed from the joint posterior (config/sequential.yaml; docs/sequential.md) into results/sequential
+	$(call study,results/sequential,all --configfile config/sequential.yaml)
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) and its HTML report into results/quick
 	$(call study,results/quick,all --configfile config/quick.yaml)

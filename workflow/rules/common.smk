@@ -9,6 +9,7 @@ from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
 from shockcal.study.next_shot_check import plan_check
+from shockcal.study.config import wave_sizes
 from shockcal.study.simulator import simulator_kind
 from shockcal.study.stages import figure_config, stage_config
 from shockcal.study.workflow import (
@@ -82,6 +83,11 @@ def run_set_settings(stage):
     return lambda w: stage_config(config, stage if w.shot in SHOTS else CANDIDATE_STAGES[stage], w.shot)
 
 
+def allow_empty(wildcards):
+    """`--allow-empty` for a sequential study's later wave (a stopped wave has no runs), else nothing."""
+    return "--allow-empty" if wildcards.run_set in WAVES else ""
+
+
 def simulations(run_set, shot):
     """Every simulation chunk of one run set's shot."""
     return expand(rules.simulate.output[0], run_set=run_set, shot=shot, chunk=RUN_SET_CHUNKS[run_set])
@@ -102,3 +108,47 @@ def check_model_shots(model):
 def check_model_settings(stage):
     """The rule param of `stage`'s config slice in the model's study."""
     return lambda w: stage_config(CHECK_PLANS[w.model]["study"] if w.model in CHECK_PLANS else config, stage)
+
+
+# A sequential study's waves (waves.smk): wave 0 is the training run set, step k every run of waves 0..k.
+def step_path(step, *parts):
+    """A step's file or directory: {RESULTS}/waves/step{step}/{parts...}."""
+    return run_set_path("waves", f"step{step}", *parts)
+
+
+def wave_design_path(wave):
+    """Wave `wave`'s design: the training design for wave 0."""
+    return DESIGN if int(wave) == 0 else run_set_path(f"wave{wave}", "design.parquet")
+
+
+def step_features(step):
+    """The features of every shot of waves 0..`step`, wave after wave."""
+    return [
+        rules.features.output[0].format(run_set=run_set, shot=shot)
+        for run_set in WAVE_RUN_SETS[: int(step) + 1]
+        for shot in SHOTS
+    ]
+
+
+def pairs(shots, paths):
+    """SHOT=FILE arguments of the `shockcal` commands, shot after shot."""
+    return " ".join(f"{shot}={path}" for shot, path in zip(shots, paths))
+
+
+def wave_design_inputs(wildcards):
+    """Wave k's design reads step k-1's posterior, runs and (max_variance) emulator, wave k-1's design
+    (empty: the study stopped) and step k-2's posterior summary (the stopping rule). Not `ancient`: a
+    change upstream (the extractor, the emulator or sampler settings) moves the posterior and so
+    re-places the later waves, as a fresh study with that config would (docs/sequential.md)."""
+    k = int(wildcards.wave)
+    inputs = {
+        "posterior": rules.wave_calibrate.output.samples.format(step=k - 1),
+        "summary": rules.wave_calibrate.output.summary.format(step=k - 1),
+        "previous": wave_design_path(k - 1),
+        "runs": rules.merge_runs.output.design.format(step=k - 1),
+        "emulator": rules.wave_emulator.output.emulator.format(step=k - 1),
+        "observed": rules.observed.output[0],
+    }
+    if k >= 2:
+        inputs["earlier"] = rules.wave_calibrate.output.summary.format(step=k - 2)
+    return inputs

@@ -13,7 +13,10 @@
 #   check:    calibration.check.trials truths on a Latin hypercube over the box, for the synthetic-truth
 #             check with hydrocode-made pseudo-measurements (calibrate.smk);
 #   next_shot: next_shot.n_draws joint-posterior draws at each next-shot candidate, whose names take the
-#             shots' place ({RESULTS}/next_shot/simulations/<candidate>/; next_shot.smk).
+#             shots' place ({RESULTS}/next_shot/simulations/<candidate>/; next_shot.smk);
+#   wave1, wave2, ...: a sequential study's later waves (design.strategy: waves; waves.smk), their sizes
+#             fixed by the config, their designs made by jobs from the previous wave's joint posterior;
+#             the training run set is then wave 0.
 
 
 DESIGN = run_set_path("training", "design.parquet")
@@ -31,6 +34,8 @@ RUN_SET_SIZES = {
     "check": config["calibration"]["check"]["trials"],
     "next_shot": config["next_shot"]["n_draws"],
 }
+WAVES = [f"wave{k}" for k in range(1, len(wave_sizes(config)))]  # none with design.strategy: lhs
+RUN_SET_SIZES.update(zip(WAVES, wave_sizes(config)[1:]))
 
 # The next-shot check (next_shot_check.smk): each compared candidate as the fourth shot of a study derived from
 # the config (its config file and training design: the study's, the candidate's inputs drawn as new columns),

@@ -5,8 +5,8 @@
 
 rule emulator:
     input:
-        design=DESIGN,
-        features=expand(rules.features.output[0], run_set="training", shot=SHOTS),
+        design=STUDY_RUNS["design"],  # the training runs; a sequential study's every wave (waves.smk)
+        features=STUDY_RUNS["features"],
     output:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",

@@ -18,8 +18,10 @@ rule features_chunk:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("features"),
+        allow_empty=allow_empty,
     shell:
-        "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget --out {output} > {log} 2>&1"
+        "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget {params.allow_empty}"
+        " --out {output} > {log} 2>&1"
 
 
 rule features:
@@ -39,8 +41,9 @@ rule features:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("failure_budget"),
+        allow_empty=allow_empty,
     shell:
-        "shockcal features --shot {wildcards.shot} --tables {input} --out {output} > {log} 2>&1"
+        "shockcal features --shot {wildcards.shot} --tables {input} {params.allow_empty} --out {output} > {log} 2>&1"
 
 
 rule observed:

@@ -31,6 +31,7 @@ rule simulate:
             else CHECK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "next_shot_check" else ""
         ),
         end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
+        allow_empty=allow_empty,
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
-        " --rows {params.rows} {params.end_time} --out {output} > {log} 2>&1"
+        " --rows {params.rows} {params.end_time} {params.allow_empty} --out {output} > {log} 2>&1"

@@ -31,6 +31,8 @@ def register(subparsers) -> None:
     p.add_argument("--first-runs", type=int, metavar="N",
                    help="fit on the design's first N rows only; the features of later runs are left out "
                         "(the next-shot check's emulators)")
+    p.add_argument("--no-cv", action="store_true",
+                   help="write the emulator only, no cross-validation tables (a sequential study's steps before the last)")
     p.add_argument("--out", required=True,
                    help="output directory (emulator.json, emulator.npz, cv.parquet, cv_heldout.parquet, cv_rmse.csv)")
     p.set_defaults(func=run)
@@ -73,6 +75,8 @@ def run(args) -> int:
     emulator = fit_emulator(design, features, spec, sources=paths)
     out = Path(args.out)
     emulator.save(out)
+    if args.no_cv:
+        return 0
     settings = config["emulator"]
     table = write_cv(emulator, out, ["loo_closed_form", *HELD_OUT], settings["cv_folds"], settings["outer_margin"])
     logging.getLogger("shockcal.emulate").info("cross-validation (m/s):\n%s", table.to_string(index=False))

@@ -28,6 +28,8 @@ def register(subparsers) -> None:
                         help="features tables of chunks of one shot's runs (--traces ... --no-failure-budget): merged")
     p.add_argument("--no-failure-budget", action="store_true",
                    help="--traces of one chunk: leave the failed-run budget (simulate.max_failed_fraction) to the merge")
+    p.add_argument("--allow-empty", action="store_true",
+                   help="--traces or --tables with no runs give an empty table (a sequential study's stopped wave)")
     p.add_argument("--time-column", help="record: time column name or index (default: detected)")
     p.add_argument("--velocity-column", help="record: velocity column name or index (default: detected)")
     p.add_argument("--out", required=True, help="output Parquet table")
@@ -66,9 +68,9 @@ def run(args) -> int:
             table = read_tables(args.tables, ["run"], "features")
         else:
             traces = read_tables(args.traces, ["run"], "simulations")
-            table = features_table(traces, settings, ", ".join(args.traces))
+            table = features_table(traces, settings, ", ".join(args.traces), args.allow_empty)
         if not args.no_failure_budget and not candidate:
-            check_failures(table, config["simulate"]["max_failed_fraction"], name)
+            check_failures(table, config["simulate"]["max_failed_fraction"], name, args.allow_empty)
     write_table(table, args.out, {"table": "features", "shot": name, "units": UNITS, "analysis": analysis})
     return 0
 

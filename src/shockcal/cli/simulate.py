@@ -30,6 +30,8 @@ def register(subparsers) -> None:
                         "--out's simulations/ folder, e.g. results/training/runs)")
     p.add_argument("--end-time-us", type=float, default=None,
                    help="simulate to this time (us) instead of hydro.end_time_us (e.g. the history figures' runs)")
+    p.add_argument("--allow-empty", action="store_true",
+                   help="a design (or --rows slice) with no rows writes an empty table (a sequential study's stopped wave)")
     p.set_defaults(func=run)
 
 
@@ -57,7 +59,7 @@ def run(args) -> int:
     else:
         mapping, spec, box = candidate(config, name).mapping(), candidate_config(config, name), candidate_box(config, name)
     geometry, material, settings = hydro_inputs(config, spec, args.end_time_us)
-    design = load_design(args.design, box, columns=mapping.inputs()).iloc[rows]
+    design = load_design(args.design, box, columns=mapping.inputs(), allow_empty=args.allow_empty).iloc[rows]
     mapping.check_positive(design, args.design)
     table = run_design(config, design, mapping, spec, (geometry, material, settings), runs_dir(args))
     units = {**UNITS, **dict.fromkeys(FEATURE_COLUMNS, "us or m/s (t_*, v_*)"), **{k: box.units[k] for k in mapping.inputs()}}

@@ -89,23 +89,25 @@ def extend_design(design: pd.DataFrame, bounds: Mapping[str, tuple[float, float]
     return extended
 
 
-def load_design(path: str | Path, box: InputBox, columns: list[str] | None = None) -> pd.DataFrame:
+def load_design(path: str | Path, box: InputBox, columns: list[str] | None = None, allow_empty: bool = False
+                ) -> pd.DataFrame:
     """Read a CSV/Parquet design, check it, and return it with an integer `run` column.
 
     Args:
         path: the design table (one row per run; `run` is added as 0..N-1 when absent).
         box: the prior box the design must lie in (`check_design_box`).
         columns: the inputs that must be present (default: all of the box's).
+        allow_empty: whether a design with no rows is fine (a sequential study's stopped wave).
 
     Run ids must be whole numbers (1.0 reads as 1; 1.5 is an error) and unique; values finite;
     Johnson-Cook inputs non-negative; velocities and shear moduli positive (checked per shot by
-    `ShotMapping.check_positive`). No rows is an error. Errors name the file, the row and the parameter.
+    `ShotMapping.check_positive`). No rows is an error unless `allow_empty`. Errors name the file, the row and the parameter.
     Returned: `run` and the box's inputs the file has (other columns, e.g. notes, are left out).
     """
     design = read_table(path)
     columns = box.names() if columns is None else columns
     require_columns(design, columns, path)
-    if design.empty:
+    if design.empty and not allow_empty:
         raise InputError(f"{path}: the design has no runs (a header and no rows)")
     if "run" not in design.columns:
         design.insert(0, "run", np.arange(len(design), dtype=np.int64))

@@ -63,3 +63,27 @@ def weighted_quantiles(x: np.ndarray, w: np.ndarray, q) -> np.ndarray:
     order = np.argsort(x)
     cdf = np.cumsum(w[order]) - 0.5 * w[order]
     return np.interp(q, cdf / w.sum(), x[order])
+
+
+def quantile_shifts(before: pd.DataFrame, after: pd.DataFrame) -> pd.DataFrame:
+    """How far each parameter's 5/50/95% points moved between two posterior summaries (`summarize`), in
+    combined Monte Carlo standard errors: |q_after - q_before| / sqrt(mcse_before^2 + mcse_after^2).
+    One row per parameter of both (column `parameter`), one column per quantile (q05, q50, q95)."""
+    both = before.merge(after, on="parameter", suffixes=("_before", "_after"))
+    shifts = {"parameter": both["parameter"]}
+    for p in SUMMARY_QUANTILES:
+        q = f"q{round(100 * p):02d}"
+        combined = np.hypot(both[f"{q}_mcse_before"], both[f"{q}_mcse_after"])
+        moved = np.abs(both[f"{q}_after"] - both[f"{q}_before"]).to_numpy()
+        with np.errstate(divide="ignore", invalid="ignore"):    # no error and no move: 0; a move without error: inf
+            shifts[q] = np.where(combined > 0, moved / combined, np.where(moved > 0, np.inf, 0.0))
+    return pd.DataFrame(shifts)
+
+
+def posterior_settled(before: pd.DataFrame, after: pd.DataFrame, threshold: float) -> bool:
+    """The stopping rule of a sequential study: no 5/50/95% point of any parameter moved by `threshold`
+    combined Monte Carlo standard errors or more (`quantile_shifts`); a threshold of 0 never settles."""
+    if threshold <= 0:
+        return False
+    shifts = quantile_shifts(before, after)
+    return bool((shifts.drop(columns="parameter").to_numpy() < threshold).all())

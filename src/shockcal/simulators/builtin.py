@@ -73,6 +73,8 @@ def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geomet
         rows.append({**row, "status": result.status, "reason": result.reason,
                      **{k: getattr(result, k) for k in DIAGNOSTICS},
                      "t_us": result.t_us, "v_m_s": result.v_m_s})
-    table = pd.DataFrame(rows)
+    columns = ["run", "shot", *inputs, "impact_velocity_m_s", "shear_modulus_GPa", "status", "reason", *DIAGNOSTICS,
+               "t_us", "v_m_s"]
+    table = pd.DataFrame(rows, columns=columns)
     table["n_steps"] = table["n_steps"].astype("Int64")
     return table

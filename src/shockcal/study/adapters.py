@@ -24,6 +24,7 @@ from shockcal.study.config import (
     prior_bounds,
     shot_config,
     velocity_box_m_s,
+    wave_sizes,
 )
 from shockcal.study.strength import DEFAULT_MODEL, strength_model
 
@@ -176,9 +177,10 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
                                check_plateau=config["checks"]["plateau_vs_velocity"])
 
 
-def load_study_design(path, config: dict, columns: list[str] | None = None) -> pd.DataFrame:
-    """`load_design` against the config's prior box (`input_box`)."""
-    return load_design(path, input_box(config), columns)
+def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False
+                      ) -> pd.DataFrame:
+    """`load_design` against the config's prior box (`input_box`); with `allow_empty`, no rows is fine."""
+    return load_design(path, input_box(config), columns, allow_empty)
 
 
 def base_inputs(config: dict) -> list[str]:
@@ -205,7 +207,8 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
                  lhs: bool = False) -> tuple[pd.DataFrame, str]:
     """(design, where it came from): the archive's design rows that have runs (`simulator.kind: archive`),
     or the config's design file (its first `n_runs` rows), or, without one or with `lhs`, a Latin
-    hypercube of `n_runs` (default design.n_runs) over the box of
+    hypercube of `n_runs` (default design.n_runs; a sequential study's wave 0, design.waves.initial_runs)
+    over the box of
     `base_inputs`, seeded from `stream` of study.seed (`shockcal.seeds`) unless `seed` is given.
 
     An input that only a shot outside `design.base_shots` reads (a shot added to a study: its own
@@ -227,7 +230,7 @@ def study_design(config: dict, n_runs: int | None = None, seed: int | None = Non
     else:
         seed = stream_seed(config["study"]["seed"], stream) if seed is None else seed
         bounds = prior_bounds(config)
-        design = latin_hypercube({n: bounds[n] for n in names if n not in extension}, n_runs or config["design"]["n_runs"],
+        design = latin_hypercube({n: bounds[n] for n in names if n not in extension}, n_runs or wave_sizes(config)[0],
                                  seed)
         source = f"Latin hypercube, seed {seed}"
     missing = {n: shot for n, shot in extension.items() if n not in design.columns}

@@ -139,3 +139,18 @@ def candidate_config(config: dict, name: str) -> dict:
     return {"flyer_mm": spec["flyer_mm"], "target_mm": spec["target_mm"], "velocity_m_s": spec["velocity_m_s"],
             "initial_temperature_K": spec.get("initial_temperature_K"), "shot": spec["shot"],
             "shear_modulus_inputs": list(reference["shear_modulus_inputs"]), "analysis": analysis}
+
+
+def wave_sizes(config: dict) -> list[int]:
+    """Runs per shot of each wave of a sequential study (`design.waves`): wave 0's `initial_runs`, then
+    `runs_per_wave` until `max_runs` is spent (the last wave takes the rest); [design.n_runs] for the
+    paper's design (`design.strategy: lhs`)."""
+    design = config["design"]
+    if design["strategy"] != "waves":
+        return [design["n_runs"]]
+    waves = design["waves"]
+    sizes, left = [waves["initial_runs"]], waves["max_runs"] - waves["initial_runs"]
+    while left > 0:
+        sizes.append(min(waves["runs_per_wave"], left))
+        left -= sizes[-1]
+    return sizes

@@ -62,6 +62,11 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
                         "observed.sd_fraction", "checks.observed_units", "checks.plateau_vs_velocity", "inputs",
                         *_SHOT_MAPPING),
+    # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
+    "wave_design": ("study.seed", "design.strategy", "design.waves", "observed.sd_fraction", "inputs",
+                    "checks.design_box", *_SHOT_MAPPING),
+    # every run of a sequential study so far, one design and one features table per shot
+    "merge_runs": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # the posterior rows run through the hydrocode for predictions
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box

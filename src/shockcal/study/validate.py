@@ -247,6 +247,7 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for shot in config["design"]["base_shots"] or []:
         if shot not in config["shots"]:
             raise ConfigError(f"{source}: design.base_shots: '{shot}' is not a shot; known shots are {sorted(config['shots'])}")
+    check_waves(config, source)
     design_file = config["design"].get("file")
     if design_file and not Path(design_file).is_file():
         raise ConfigError(f"{source}: design.file: {design_file} does not exist")
@@ -275,6 +276,23 @@ def check_semantics(config: dict, source: str = "config") -> None:
             raise ConfigError(f"{source}: observed.{source_section}.{shot}: missing, and observed.source is "
                               f"{observed['source']!r}; give it, or set observed.source to "
                               f"{'published' if source_section == 'records' else 'records'}")
+
+
+def check_waves(config: dict, source: str = "config") -> None:
+    """A sequential study's budget holds wave 0 (`design.waves.max_runs` >= `initial_runs`), its wave 0 is a
+    Latin hypercube (no `design.file`), and its runs are made, not looked up (no `simulator.kind: archive`)."""
+    if config["design"]["strategy"] != "waves":
+        return
+    waves = config["design"]["waves"]
+    if waves["max_runs"] < waves["initial_runs"]:
+        raise ConfigError(f"{source}: design.waves.max_runs: {waves['max_runs']} is below wave 0's "
+                          f"design.waves.initial_runs ({waves['initial_runs']}); the budget must hold wave 0")
+    if config["design"]["file"]:
+        raise ConfigError(f"{source}: design.file: a design file and design.strategy: waves do not go together "
+                          "(wave 0 is a Latin hypercube); set one of them")
+    if (config.get("simulator") or {}).get("kind") == "archive":
+        raise ConfigError(f"{source}: simulator.kind: an archive holds only the runs it has, and design.strategy: "
+                          "waves places new ones; use design.strategy: lhs with an archive")
 
 
 def _law_has_modulus(config: dict) -> bool:

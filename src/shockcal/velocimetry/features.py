@@ -365,7 +365,8 @@ def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) ->
     return extract(t, v, settings).features
 
 
-def features_table(traces, settings: ExtractorSettings, source: str = "simulations") -> pd.DataFrame:
+def features_table(traces, settings: ExtractorSettings, source: str = "simulations", allow_empty: bool = False
+                   ) -> pd.DataFrame:
     """One row per simulated run (a simulations table: run, status, reason, t_us, v_m_s): run, status,
     reason and the ten features.
 
@@ -373,14 +374,15 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
     status "failed" with the extractor's reason. A row that carries the ten features and no trace (an
     external code's or an archive's features) keeps them as they are. A table that is not a simulations table (columns
     missing, no rows, run ids that are not whole numbers, traces that are not lists of numbers: a CSV
-    copy of a chunk) is an InputError naming `source` and the run.
+    copy of a chunk) is an InputError naming `source` and the run; no rows is fine with `allow_empty`
+    (a sequential study's stopped wave).
     """
     import pandas as pd
 
     from shockcal.io import integer_ids, require_columns
 
     require_columns(traces, ["run", "status", "reason", "t_us", "v_m_s"], source)
-    if traces.empty:
+    if traces.empty and not allow_empty:
         raise InputError(f"{source}: no runs (a simulations table with no rows)")
     traces = integer_ids(traces, "run", source)
     rows = []
@@ -395,7 +397,7 @@ def features_table(traces, settings: ExtractorSettings, source: str = "simulatio
             except FeatureError as exc:
                 row.update(status="failed", reason=f"feature extraction: {exc}")
         rows.append(row)
-    table = pd.DataFrame(rows)
+    table = pd.DataFrame(rows) if rows else pd.DataFrame(columns=["run", "status", "reason"])
     for column in COLUMNS:
         table[column] = table[column].astype(float) if column in table else np.nan
     return table[["run", "status", "reason", *COLUMNS]].sort_values("run").reset_index(drop=True)
@@ -463,13 +465,16 @@ def _column(value):
     return int(value) if isinstance(value, str) and value.isdigit() else value
 
 
-def check_failures(table, max_fraction: float, shot: str) -> None:
+def check_failures(table, max_fraction: float, shot: str, allow_empty: bool = False) -> None:
     """Log the excluded count and their reasons; stop in one line naming the shot, the count and the commonest
-    reason (`reason_kind`) when more than `max_fraction` of the runs failed, or when there are no runs (or
-    no `status` column: not a features table)."""
+    reason (`reason_kind`) when more than `max_fraction` of the runs failed, or when there are no runs (unless
+    `allow_empty`: a sequential study's stopped wave; or no `status` column: not a features table)."""
     from shockcal.io import require_columns
 
     require_columns(table, ["run", "status", "reason"], f"features of shot {shot}")
+    if table.empty and allow_empty:
+        log.info("shot %s: no runs (a stopped wave)", shot)
+        return
     if table.empty:
         raise InputError(f"features of shot {shot}: no runs (a features table with no rows)")
     failed = table[table["status"] != "ok"]

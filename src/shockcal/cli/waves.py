@@ -1,0 +1,133 @@
+"""`shockcal wave-design` (a later wave's design from the previous wave's joint posterior) and
+`shockcal merge-runs` (every run of a sequential study so far, as one design and one features table per
+shot): docs/sequential.md. Config keys: `design.waves`, `inputs`, study.seed (shockcal.study.stages)."""
+
+from __future__ import annotations
+
+from shockcal.cli import add_config_argument
+
+
+def register(subparsers) -> None:
+    w = subparsers.add_parser("wave-design", help="a later wave's design: the previous joint posterior thinned")
+    add_config_argument(w)
+    w.add_argument("--wave", required=True, type=int, help="the wave's number (1 for the first after wave 0)")
+    w.add_argument("--posterior", required=True,
+                   help="the previous wave's joint posterior samples (its summary beside it: *_summary.parquet)")
+    w.add_argument("--earlier-summary",
+                   help="the joint posterior summary of the wave before the previous one (the stopping rule)")
+    w.add_argument("--previous-design", required=True,
+                   help="the previous wave's design: when it is empty (the study stopped), so is this one")
+    w.add_argument("--runs", required=True, help="every run so far (merge-runs' design.parquet)")
+    w.add_argument("--emulator", help="the previous wave's emulator directory (criterion max_variance)")
+    w.add_argument("--observed", help="the observed features table (criterion max_variance)")
+    w.add_argument("--out", required=True, help="the wave's design table (Parquet)")
+    w.set_defaults(func=run_wave_design)
+
+    m = subparsers.add_parser("merge-runs", help="designs and features of several run sets as one of each")
+    add_config_argument(m)
+    m.add_argument("--designs", required=True, nargs="+", help="design tables (run ids unique over all of them)")
+    m.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
+                   help="features tables, a shot's tables each given as SHOT=FILE")
+    m.add_argument("--out", required=True, help="directory: design.parquet and features/SHOT.parquet")
+    m.set_defaults(func=run_merge)
+
+
+def run_wave_design(args) -> int:
+    import logging
+
+    from shockcal.design.waves import wave_design
+    from shockcal.errors import InputError
+    from shockcal.inference.posterior_files import companion_path
+    from shockcal.inference.summaries import posterior_settled, quantile_shifts
+    from shockcal.io import read_table, write_table
+    from shockcal.seeds import stream_seed
+    from shockcal.study.adapters import load_study_design
+    from shockcal.study.config import prior_bounds, wave_sizes
+    from shockcal.study.stages import load_stage_config
+
+    log = logging.getLogger("shockcal.design.waves")
+    config = load_stage_config(args.config, "wave_design")
+    if config["design"]["strategy"] != "waves":
+        raise InputError(f"wave-design: design.strategy is {config['design']['strategy']!r}; waves need 'waves'")
+    sizes, waves = wave_sizes(config), config["design"]["waves"]
+    if not 1 <= args.wave < len(sizes):
+        raise InputError(f"--wave: {args.wave} is not a later wave of this study (1 to {len(sizes) - 1})")
+    n_runs, stopped = sizes[args.wave], ""
+    if load_study_design(args.previous_design, config, allow_empty=True).empty:
+        stopped = f"the previous wave ({args.previous_design}) is empty: the study stopped before it"
+    elif args.earlier_summary:
+        before, after = read_table(args.earlier_summary), read_table(companion_path(args.posterior))
+        shifts = quantile_shifts(before, after)
+        log.info("joint posterior's 5/50/95%% points moved (combined Monte Carlo SE):\n%s",
+                 shifts.to_string(index=False, float_format="%.2f"))
+        if posterior_settled(before, after, waves["stop_mcse"]):
+            stopped = f"no 5/50/95% point moved by {waves['stop_mcse']:g} combined Monte Carlo SE (design.waves.stop_mcse)"
+    runs = load_study_design(args.runs, config)
+    variance = None
+    if waves["criterion"] == "max_variance" and not stopped:
+        variance = max_variance_score(args, config)
+    design = wave_design(read_table(args.posterior), prior_bounds(config), 0 if stopped else n_runs,
+                         int(runs["run"].max()) + 1, stream_seed(config["study"]["seed"], "waves", "pool", args.wave),
+                         existing=runs, widen=waves["widen"], pool_size=waves["pool_size"],
+                         criterion=waves["criterion"], variance=variance, source=args.posterior)
+    units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
+    write_table(design, args.out, {"table": "design", "units": units, "stopped": stopped,
+                                   "source": f"wave {args.wave}: {waves['criterion']} from {args.posterior}"})
+    log.info("wave %d: %s", args.wave, f"stopped, no runs: {stopped}" if stopped else
+             f"{len(design)} runs (ids {design['run'].min()}-{design['run'].max()}) -> {args.out}")
+    return 0
+
+
+def max_variance_score(args, config):
+    """The max_variance criterion's score of a candidate table: the previous emulator's predictive
+    variance over the observation variance (`relative_variance`), summed over every shot's features."""
+    import numpy as np
+
+    from shockcal.cli.calibrate import study_emulator
+    from shockcal.design.waves import relative_variance
+    from shockcal.errors import InputError
+    from shockcal.io import read_table
+    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+
+    if not args.emulator or not args.observed:
+        raise InputError("wave-design: design.waves.criterion max_variance needs --emulator and --observed")
+    emulator, observed = study_emulator(args.emulator, config), read_table(args.observed).set_index("shot")
+    shots = list(config["shots"])
+    sd = np.concatenate([config["observed"]["sd_fraction"] * observed.loc[s, CALIBRATION_FEATURES].to_numpy(float)
+                         for s in shots])
+    return lambda pool: relative_variance(emulator, pool, shots, sd)
+
+
+def run_merge(args) -> int:
+    import logging
+    from pathlib import Path
+
+    import pandas as pd
+
+    from shockcal.errors import InputError
+    from shockcal.io import read_table, read_tables, write_table
+    from shockcal.study.adapters import load_study_design
+    from shockcal.study.stages import load_stage_config
+
+    config = load_stage_config(args.config, "merge_runs")
+    designs = [load_study_design(path, config, allow_empty=True) for path in args.designs]
+    design = pd.concat(designs, ignore_index=True)
+    if design["run"].duplicated().any():
+        run = design.loc[design["run"].duplicated(), "run"].iloc[0]
+        raise InputError(f"run id {run} is in more than one of the designs {' '.join(args.designs)}")
+    by_shot: dict[str, list[str]] = {}
+    for pair in args.features:
+        shot, sep, path = pair.partition("=")
+        if not sep or not shot or not path:
+            raise InputError(f"--features: '{pair}' is not SHOT=FILE")
+        by_shot.setdefault(shot, []).append(path)
+    out = Path(args.out)
+    write_table(design, out / "design.parquet", {"table": "design", "source": f"merged from {' '.join(args.designs)}",
+                                                 "units": {k: config["inputs"][k]["unit"] for k in config["inputs"]}})
+    for shot, paths in by_shot.items():
+        with_runs = [path for path in paths if not read_table(path).empty]     # a stopped wave's table has none
+        table = read_tables(with_runs or paths[:1], ["run"], "features")
+        write_table(table, out / "features" / f"{shot}.parquet", {"table": "features", "shot": shot,
+                                                                  "merged": paths})
+    logging.getLogger("shockcal.design.waves").info("%d runs of %d designs -> %s", len(design), len(designs), out)
+    return 0

@@ -1,0 +1,127 @@
+# A sequential study (design.strategy: waves; docs/sequential.md). The DAG is static: the wave sizes are
+# config keys, so every wave's chunks are known when the workflow is read, and only a wave design's
+# content comes from a job: wave k's design reads step k-1's joint posterior (step k: the emulator refitted
+# on waves 0..k and the shots recalibrated jointly). A stopped study (design.waves.stop_mcse) writes empty
+# wave designs, whose zero-row chunks cost nothing. The last step's emulator and joint posterior are the
+# study's own ({RESULTS}/emulator, {RESULTS}/posterior/joint*: emulator.smk, calibrate.smk), so figures,
+# predictions and the report read them unchanged. With design.strategy: lhs there are no waves and the
+# emulator is fitted on the training runs.
+#
+#   {RESULTS}/wave{k}/{design.parquet, simulations/, features/}: wave k's runs (the run set "wave{k}")
+#   {RESULTS}/waves/step{k}/{design.parquet, features/}: every run of waves 0..k
+#   {RESULTS}/waves/step{k}/{emulator/, posterior/}: their emulator and joint posterior (k before the last)
+
+WAVE_RUN_SETS = ["training", *WAVES]  # wave 0 is the training run set
+LAST_STEP = len(WAVES)
+
+
+rule merge_runs:
+    """Every run of waves 0..step: one design, one features table per shot."""
+    input:
+        designs=lambda w: [wave_design_path(k) for k in range(int(w.step) + 1)],
+        features=lambda w: step_features(w.step),
+    output:
+        design=step_path("{step}", "design.parquet"),
+        features=[step_path("{step}", "features", f"{shot}.parquet") for shot in SHOTS],
+    log:
+        f"{LOGS}/waves/step{{step}}/merge_runs.log",
+    benchmark:
+        f"{BENCHMARKS}/waves/step{{step}}/merge_runs.tsv"
+    wildcard_constraints:
+        step=r"\d+",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(config, "merge_runs"),
+        pairs=lambda w, input: pairs(SHOTS * (int(w.step) + 1), input.features),
+        out=lambda w: step_path(w.step),
+    shell:
+        "shockcal merge-runs --designs {input.designs} --features {params.pairs} --out {params.out} > {log} 2>&1"
+
+
+rule wave_emulator:
+    """The emulator of every run of waves 0..step (a step before the last: the last is the study's)."""
+    input:
+        design=rules.merge_runs.output.design,
+        features=rules.merge_runs.output.features,
+    output:
+        emulator=step_path("{step}", "emulator", "emulator.json"),
+        arrays=step_path("{step}", "emulator", "emulator.npz"),
+    log:
+        f"{LOGS}/waves/step{{step}}/emulator.log",
+    benchmark:
+        f"{BENCHMARKS}/waves/step{{step}}/emulator.tsv"
+    wildcard_constraints:
+        step=r"\d+",
+    conda:
+        "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]
+    params:
+        settings=stage_config(config, "emulate"),
+        pairs=lambda w, input: pairs(SHOTS, input.features),
+        out=lambda w, output: os.path.dirname(output.emulator),
+    shell:
+        "shockcal emulate --design {input.design} --features {params.pairs} --no-cv --out {params.out} > {log} 2>&1"
+
+
+rule wave_calibrate:
+    """The joint posterior of waves 0..step's emulator (a step before the last)."""
+    input:
+        emulator=rules.wave_emulator.output.emulator,
+        observed=rules.observed.output[0],
+    output:
+        samples=step_path("{step}", "posterior", "joint.parquet"),
+        summary=step_path("{step}", "posterior", "joint_summary.parquet"),
+        weighted=step_path("{step}", "posterior", "joint_weighted.parquet"),
+    log:
+        f"{LOGS}/waves/step{{step}}/calibrate.log",
+    benchmark:
+        f"{BENCHMARKS}/waves/step{{step}}/calibrate.tsv"
+    wildcard_constraints:
+        step=r"\d+",
+    conda:
+        "../envs/shockcal.yaml"
+    threads: config["emulator"]["n_jobs"]
+    params:
+        settings=stage_config(config, "calibrate"),
+        shots=" ".join(SHOTS),
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+    shell:
+        "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots}"
+        " --observed {input.observed} --out {output.samples} > {log} 2>&1"
+
+
+rule wave_design:
+    """A later wave's design: the previous joint posterior thinned (design.waves.criterion), or no runs
+    once the posterior stopped moving (design.waves.stop_mcse)."""
+    input:
+        unpack(wave_design_inputs),
+    output:
+        f"{RESULTS}/wave{{wave}}/design.parquet",
+    log:
+        f"{LOGS}/wave{{wave}}/design.log",
+    benchmark:
+        f"{BENCHMARKS}/wave{{wave}}/design.tsv"
+    wildcard_constraints:
+        wave=r"[1-9]\d*",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(config, "wave_design"),
+        earlier=lambda w, input: f"--earlier-summary {input.earlier}" if "earlier" in input.keys() else "",
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+    shell:
+        "shockcal wave-design --wave {wildcards.wave} --posterior {input.posterior} {params.earlier}"
+        " --previous-design {input.previous} --runs {input.runs} --emulator {params.emulator_dir}"
+        " --observed {input.observed} --out {output} > {log} 2>&1"
+
+
+# the study's emulator (emulator.smk) is fitted on these runs
+STUDY_RUNS = {
+    "design": rules.merge_runs.output.design.format(step=LAST_STEP) if WAVES else DESIGN,
+    "features": (
+        [step_path(LAST_STEP, "features", f"{shot}.parquet") for shot in SHOTS]
+        if WAVES
+        else expand(rules.features.output[0], run_set="training", shot=SHOTS)
+    ),
+}
