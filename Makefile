@@ -97,8 +97,11 @@ test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 test-slow: $(INSTALLED)  ## the slow checks only
 	$(VENV)/bin/pytest -m slow
 
-test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (root: installs slurm-wlm, munge)
-	tests/slurm/run_slurm_test.sh
+# SLURM_OVERLAY: config files over config/quick.yaml for test-slurm's runs, e.g. the example external code:
+# make test-slurm SLURM_OVERLAY=examples/external_hydro/quick-command.yaml
+SLURM_OVERLAY ?=
+test-slurm: $(INSTALLED)  ## the quick study on a throwaway single-node SLURM (root: installs slurm-wlm, munge); SLURM_OVERLAY=config for another run source
+	tests/slurm/run_slurm_test.sh $(foreach f,$(SLURM_OVERLAY),--overlay $(f))
 
 bench: $(INSTALLED)  ## speed and memory figures (printed, never asserted); installs the reference samplers
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test,bench]'

@@ -2,7 +2,8 @@
 local run; run by tests/slurm/run_slurm_test.sh (`make test-slurm`), which starts and stops the cluster.
 
 1. local reference: `snakemake all --cores 2 --configfile config/quick.yaml <results in WORK/local>`
-   (or --reference DIR: the results directory of a finished local quick study);
+   (or --reference DIR: the results directory of a finished local quick study); `--overlay CONFIG`
+   puts a config file over config/quick.yaml in every run (`make test-slurm SLURM_OVERLAY=...`);
 2. SLURM run 1, the profile as shipped: once a simulate job is running shockcal (its log exists), it is
    cancelled with scancel; the profile's retry resubmits it; the retry is cancelled too, so the chunk
    fails for good. Checks: each cancellation is detected within the bounded time, the run finishes the
@@ -139,9 +140,12 @@ def overlay(path: Path, results: Path) -> Path:
     return path
 
 
+OVERLAYS: list[str] = []   # --overlay: config files between config/quick.yaml and the results overlay
+
+
 def snakemake_args(config: Path, *extra: str) -> list[str]:
     # targets and options first: --configfile takes every argument after it
-    return ["all", *extra, "--configfile", "config/quick.yaml", str(config)]
+    return ["all", *extra, "--configfile", "config/quick.yaml", *OVERLAYS, str(config)]
 
 
 def tables(results: Path) -> dict[str, Path]:
@@ -174,8 +178,14 @@ def compare(local: Path, slurm: Path) -> list[str]:
 
 
 def mtimes(results: Path) -> dict[str, int]:
+    """Every finished file: a command simulator's run folder ({run_set}/runs/{shot}/{run}/) counts only once its
+    run has finished (its done.json, written last); a run the cancellation cut short is redone, as it should be."""
+    def finished(parts: tuple[str, ...]) -> bool:
+        return len(parts) < 5 or parts[1] != "runs" or (results.joinpath(*parts[:4]) / "done.json").exists()
+
     return {str(p.relative_to(results)): p.stat().st_mtime_ns for p in results.rglob("*")
-            if p.is_file() and p.relative_to(results).parts[0] not in ("logs", "benchmarks", "config")}
+            if p.is_file() and p.relative_to(results).parts[0] not in ("logs", "benchmarks", "config")
+            and finished(p.relative_to(results).parts)}
 
 
 def job_stats(text: str) -> dict[str, int]:
@@ -385,7 +395,11 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--work", type=Path, required=True, help="scratch directory (results, logs)")
     parser.add_argument("--reference", type=Path, help="results of a finished local quick study to compare with")
+    parser.add_argument("--overlay", action="append", default=[], metavar="CONFIG",
+                        help="a config file over config/quick.yaml for every run, local and SLURM (e.g. "
+                             "examples/external_hydro/quick-command.yaml: the example external code)")
     args = parser.parse_args()
+    OVERLAYS.extend(args.overlay)
     work = args.work.resolve()
     failures: list[str] = []
     t_start = time.time()

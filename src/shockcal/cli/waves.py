@@ -4,11 +4,24 @@ shot): docs/sequential.md. Config keys: `design.waves`, `inputs`, study.seed (sh
 
 from __future__ import annotations
 
-from shockcal.cli import add_config_argument
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_WAVE_DESIGN = """\
+shockcal wave-design --config config/sequential.yaml --wave 2 \\
+    --posterior results/sequential/waves/step1/posterior/joint.parquet \\
+    --earlier-summary results/sequential/waves/step0/posterior/joint_summary.parquet \\
+    --previous-design results/sequential/wave1/design.parquet --runs results/sequential/waves/step1/design.parquet \\
+    --out results/sequential/wave2/design.parquet"""
+EXAMPLE_MERGE_RUNS = """\
+shockcal merge-runs --config config/sequential.yaml \\
+    --designs results/sequential/training/design.parquet results/sequential/wave1/design.parquet \\
+    --features 104S=results/sequential/training/features/104S.parquet 104S=results/sequential/wave1/features/104S.parquet \\
+    --out results/sequential/waves/step1"""
 
 
 def register(subparsers) -> None:
-    w = subparsers.add_parser("wave-design", help="a later wave's design: the previous joint posterior thinned")
+    w = add_command(subparsers, "wave-design", help="a later wave's design: the previous joint posterior thinned",
+                    example=EXAMPLE_WAVE_DESIGN)
     add_config_argument(w)
     w.add_argument("--wave", required=True, type=int, help="the wave's number (1 for the first after wave 0)")
     w.add_argument("--posterior", required=True,
@@ -23,7 +36,8 @@ def register(subparsers) -> None:
     w.add_argument("--out", required=True, help="the wave's design table (Parquet)")
     w.set_defaults(func=run_wave_design)
 
-    m = subparsers.add_parser("merge-runs", help="designs and features of several run sets as one of each")
+    m = add_command(subparsers, "merge-runs", help="designs and features of several run sets as one of each",
+                    example=EXAMPLE_MERGE_RUNS)
     add_config_argument(m)
     m.add_argument("--designs", required=True, nargs="+", help="design tables (run ids unique over all of them)")
     m.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",

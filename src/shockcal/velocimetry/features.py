@@ -496,5 +496,8 @@ def check_failures(table, max_fraction: float, shot: str, allow_empty: bool = Fa
 
 def reason_kind(reason: str) -> str:
     """What a failed run's reason says without its particulars: the text before its first ':', numbers as #
-    ("nonzero exit", "output truncated", "negative cell volume in cell # (target) at t = # us after # steps")."""
+    ("nonzero exit", "output truncated", "negative cell volume in cell # (target) at t = # us after # steps");
+    a missing reason (NaN in a table read back) is "(no reason given)"."""
+    if not isinstance(reason, str):
+        return "(no reason given)"
     return re.sub(r"[-+]?\d+(\.\d*)?([eE][-+]?\d+)?", "#", reason.split(":")[0].strip()) or "(no reason given)"
