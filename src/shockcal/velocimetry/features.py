@@ -481,14 +481,15 @@ def check_failures(table, max_fraction: float, shot: str, allow_empty: bool = Fa
     if failed.empty:
         log.info("shot %s: all %d runs have features", shot, len(table))
         return
-    kinds = failed["reason"].astype(str).map(reason_kind).value_counts()
+    kind_of_run = failed["reason"].astype(str).map(reason_kind)
+    kinds = kind_of_run.value_counts()
     log.warning("shot %s: %d of %d runs failed and are excluded downstream; by reason: %s", shot, len(failed),
                 len(table), "; ".join(f"{kind} ({count})" for kind, count in kinds.items()))
     for r in failed.head(10).itertuples():
         log.warning("  run %s: %s", r.run, r.reason)
     if len(failed) > max_fraction * len(table):
         commonest = kinds.index[0]
-        example = failed[failed["reason"].astype(str).map(reason_kind) == commonest].iloc[0]
+        example = failed[kind_of_run == commonest].iloc[0]
         raise ShockcalError(f"shot {shot}: {len(failed)} of {len(table)} runs failed, more than the allowed "
                             f"{max_fraction:.0%} (simulate.max_failed_fraction); the commonest reason, "
                             f"{kinds.iloc[0]} runs: {commonest} (e.g. run {example['run']}: {example['reason']})")
