@@ -31,10 +31,9 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from shockcal.design.waves import relative_variance, wave_design
-from shockcal.emulator.study_emulator import fit_emulator
+from shockcal.emulator import fit_emulator, score_heldout
 from shockcal.inference.calibration import calibrate
 from shockcal.inference.predict import draw_posterior_design
 from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
@@ -84,17 +83,10 @@ def run_features(design: pd.DataFrame, shots, pool: ProcessPoolExecutor, chunk: 
     return {shot: pd.concat([t for (s, _), t in zip(tasks, tables) if s == shot], ignore_index=True) for shot in shots}
 
 
-def heldout_scores(emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame], shots) -> tuple[float, float]:
+def heldout_scores(emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame]) -> tuple[float, float]:
     """(RMSE m/s, share inside the error model's central 90% band) at the held-out runs every shot ran."""
-    ok = {s: t[t["status"] == "ok"].set_index("run") for s, t in features.items()}
-    runs = sorted(set.intersection(*(set(t.index) for t in ok.values())))
-    rows = design.set_index("run").loc[runs]
-    mean, cov = emulator.predict({k: rows[k].to_numpy() for k in rows.columns}, shots)
-    truth = np.column_stack([ok[s].loc[runs, f].to_numpy() for s in shots for f in CALIBRATION_FEATURES])
-    z = (mean - truth) / np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
-    error = emulator.blocks[0].model.error
-    inside = np.abs(z) <= np.sqrt(error.scale) * stats.t.ppf(0.95, error.dof)
-    return float(np.sqrt(np.mean((mean - truth) ** 2))), float(np.mean(inside))
+    overall = score_heldout(emulator, design, features).iloc[-1]
+    return float(overall["rmse_m_s"]), float(overall["coverage"])
 
 
 def save(directory: Path | None, name: str, design: pd.DataFrame, features: dict[str, pd.DataFrame]) -> None:
@@ -167,7 +159,7 @@ def main() -> None:
                                         criterion="max_variance",
                                         variance=lambda pool_: relative_variance(emulator0, pool_, shots, obs_sd)),
         }
-        rmse0, cover0 = heldout_scores(emulator0, heldout, held_features, shots)
+        rmse0, cover0 = heldout_scores(emulator0, heldout, held_features)
         print(f"{'arm':>13}{'runs/shot':>10}{'held-out RMSE':>14}{'in 90%':>8}{'10-fold RMSE':>13}{'fit s':>7}"
               f"{'new runs in wave-0 90%':>23}{'posterior move':>22}")
         print(f"{'wave 0':>13}{args.n0:10d}{rmse0:14.2f}{cover0:8.3f}{kfold_rmse(emulator0):13.2f}{'':>7}"
@@ -175,13 +167,13 @@ def main() -> None:
         for name, added in [(name, arms[name]) for name in args.arms]:
             features = run_features(added, shots, pool)
             save(args.save, name, added, features)
-            _, new_cover = heldout_scores(emulator0, added, features, shots)
+            _, new_cover = heldout_scores(emulator0, added, features)
             design = pd.concat([wave0, added], ignore_index=True)
             fit_start = time.perf_counter()
             emulator = fit_emulator(design, {s: pd.concat([features0[s], features[s]], ignore_index=True)
                                              for s in shots}, spec)
             fit_s = time.perf_counter() - fit_start
-            rmse, cover = heldout_scores(emulator, heldout, held_features, shots)
+            rmse, cover = heldout_scores(emulator, heldout, held_features)
             move = ""
             if args.posteriors:
                 move = posterior_move(calibrate(emulator, shots, observed, settings).draws, reference, bounds)

@@ -5,8 +5,10 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 from shockcal.emulator.gp import GaussianProcess
+from shockcal.emulator.heldout import score_heldout
 from shockcal.emulator.study_emulator import Emulator, fit_emulator, rmse_table
 from shockcal.errors import InputError
 from shockcal.study.adapters import emulator_spec
@@ -75,6 +77,28 @@ def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
     assert mean.shape == (20, 4) and cov.shape == (20, 4, 4)
     assert np.sqrt(np.mean((mean - known_function(x_new)) ** 2)) < 4 * NOISE
     assert np.all(np.linalg.eigvalsh(cov) > 0)
+
+
+def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
+    design, features, _ = _synthetic_study(paper_config, n=90)
+    paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
+    emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
+    new, new_features, _ = _synthetic_study(paper_config, n=200, seed=9)
+    table = score_heldout(emulator, new, {"104S": new_features})
+    assert list(table["feature"]) == [f"104S:{f}" for f in CALIBRATION_FEATURES] + ["all (200 runs)"]
+    assert table["rmse_m_s"].iloc[-1] < 4 * NOISE and 0.8 <= table["coverage"].iloc[-1] <= 0.98   # the bands hold
+    mean, cov = emulator.predict({k: new[k].to_numpy() for k in new.columns}, ["104S"])
+    sd = np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
+    error = emulator.blocks[0].model.error
+    half = np.sqrt(error.scale) * stats.t.ppf(0.95, error.dof) * sd
+    for shift, coverage in [(0.0, 1.0), (0.99, 1.0), (1.01, 0.0)]:     # just inside or outside the band
+        exact = new_features.copy()
+        exact[CALIBRATION_FEATURES] = mean + shift * half
+        scored = score_heldout(emulator, new, {"104S": exact}).iloc[-1]
+        assert scored["coverage"] == coverage
+        assert scored["rmse_m_s"] == pytest.approx(np.sqrt(np.mean((shift * half) ** 2)), rel=1e-12, abs=1e-12)
+    failed = new_features.assign(status=np.where(new_features["run"] < 10, "failed", "ok"))
+    assert score_heldout(emulator, new, {"104S": failed})["n_values"].iloc[0] == 190
 
 
 def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path, paper_config):

@@ -4,7 +4,8 @@
 array-level `PCGPEmulator` and its `Settings`: fit, predict, K-fold, save, load) with its error model
 (`error_model`: Student t or Gaussian) and the error's variance over the box (`variance_model`);
 `study_emulator` maps a study's design columns and shots onto PC-GP blocks (`fit_emulator`,
-`Emulator`). Hands on a fitted emulator (`emulator.npz` + `emulator.json`) to the inference.
+`Emulator`); `heldout` scores one on runs it was not fitted on (`score_heldout`). Hands on a fitted
+emulator (`emulator.npz` + `emulator.json`) to the inference.
 """
 
 from shockcal._lazy import lazy_exports
@@ -15,4 +16,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "Emulator": "shockcal.emulator.study_emulator",
     "EmulatorSpec": "shockcal.emulator.study_emulator",
     "fit_emulator": "shockcal.emulator.study_emulator",
+    "score_heldout": "shockcal.emulator.heldout",
 })
