@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import copy
+import os
+import shutil
+import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -36,17 +40,53 @@ def reference_data() -> Path:
     return path
 
 
+class BackgroundStudy:
+    """The quick study (config/quick.yaml, about two minutes on 2 idle cores) run end to end by snakemake
+    in the background, into a temporary results directory, from the end of collection on: the tests that
+    do not need it run meanwhile (pytest uses one core, the study's jobs the other)."""
+
+    def __init__(self, root: Path):
+        self.results, self.overlay, self.log = root / "results", root / "results.yaml", root / "snakemake.log"
+        self.overlay.write_text(yaml.safe_dump({"study": {"results_dir": str(self.results)}}))
+        snakemake = str(Path(sys.executable).parent / "snakemake")
+        with self.log.open("w") as log:
+            self.process = subprocess.Popen([snakemake, "all", "--cores", "2", "--configfile", "config/quick.yaml",
+                                             str(self.overlay)], cwd=REPO, stdout=log, stderr=subprocess.STDOUT,
+                                            start_new_session=True)
+
+    def wait(self) -> tuple[Path, Path]:
+        """(the results directory, the config overlay naming it) once the study has finished; the test
+        fails with the end of snakemake's output when it did not."""
+        if self.process.wait() != 0:
+            pytest.fail(f"the quick study failed:\n{self.log.read_text()[-6000:]}")
+        return self.results, self.overlay
+
+    def stop(self) -> None:
+        """Stop the study and its jobs when the session ends before it (an error with -x, Ctrl-C)."""
+        if self.process.poll() is None:
+            os.killpg(self.process.pid, signal.SIGTERM)
+            self.process.wait()
+
+
+QUICK_STUDY = pytest.StashKey[BackgroundStudy]()
+
+
+def pytest_collection_finish(session):
+    """Start the quick study as soon as the tests are known, when one of them needs it."""
+    if any("quick_study" in item.fixturenames for item in session.items):
+        root = Path(tempfile.mkdtemp(prefix="shockcal-quick-"))
+        session.config.stash[QUICK_STUDY] = BackgroundStudy(root)
+
+
+def pytest_sessionfinish(session):
+    study = session.config.stash.get(QUICK_STUDY, None)
+    if study is not None:
+        study.stop()
+        shutil.rmtree(study.results.parent, ignore_errors=True)
+
+
 @pytest.fixture(scope="session")
-def quick_study(tmp_path_factory) -> tuple[Path, Path]:
-    """The quick study (config/quick.yaml, about two minutes on 2 idle cores) run once per session, end to
-    end, into a temporary results directory: (that directory, the config overlay naming it). Tests that
-    need a finished study read it; none may change it for good."""
-    root = tmp_path_factory.mktemp("quick")
-    results, overlay = root / "results", root / "results.yaml"
-    overlay.write_text(yaml.safe_dump({"study": {"results_dir": str(results)}}))
-    snakemake = str(Path(sys.executable).parent / "snakemake")
-    done = subprocess.run([snakemake, "all", "--cores", "2", "--configfile", "config/quick.yaml", str(overlay)],
-                          cwd=REPO, capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.fail(f"the quick study failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
-    return results, overlay
+def quick_study(request) -> tuple[Path, Path]:
+    """The finished quick study (`BackgroundStudy`): (its results directory, the config overlay naming
+    it). Tests that need a finished study read it; none may change it for good."""
+    return request.config.stash[QUICK_STUDY].wait()
