@@ -130,6 +130,7 @@ def main() -> None:
 def plot(table: pd.DataFrame, path: Path) -> None:
     """RMSE and band coverage on the held-out runs, and the posterior's distance, against training runs."""
     import matplotlib
+    import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -141,9 +142,11 @@ def plot(table: pd.DataFrame, path: Path) -> None:
         axes[2].plot(part["training_runs"], part["max_move_box"], marker=marker, label=design)
     axes[1].axhspan(0.88, 0.92, color="0.85", label="0.88-0.92")
     axes[2].axhline(0.02, color="0.5", ls="--", label="0.02 of the box")
-    labels = ("held-out RMSE (m/s)", "share in the 90% band", "largest 5/50/95% move (box)")
+    labels = ("held-out RMSE (m/s)", "share in the 90% band", "largest 5/50/95% move from 3000 runs (box)")
     for ax, label in zip(axes, labels):
         ax.set_xscale("log")
+        ax.set_xticks([300, 600, 1000, 3000], ["300", "600", "1000", "3000"])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("training hydrocode runs (all shots)")
         ax.set_ylabel(label)
         ax.legend(fontsize=8)
