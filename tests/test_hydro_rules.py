@@ -59,6 +59,8 @@ def test_a_plate_thinner_than_one_cell_is_refused_before_the_run():
     ("hydro", "cfl", 1.5, lambda: HydroSettings(cfl=1.5)),
     ("hydro", "q_quadratic", -1.0, lambda: HydroSettings(q_quadratic=-1.0)),
     ("material", "T_melt_K", float("nan"), lambda: MaterialProperties(**{**AL5083.__dict__, "T_melt_K": float("nan")})),
+    ("material", "T_melt_K", 298.0, lambda: MaterialProperties(**{**AL5083.__dict__, "T_melt_K": 298.0})),
+    ("material", "T_melt_K", 250.0, lambda: MaterialProperties(**{**AL5083.__dict__, "T_melt_K": 250.0})),
     ("next_shot.candidates.fast", "velocity_m_s", 204000, lambda: ShotParameters(**JC_104S, velocity_m_s=204000)),
     ("next_shot.candidates.fast", "velocity_m_s", -204, lambda: ShotParameters(**JC_104S, velocity_m_s=-204)),
 ])

@@ -103,6 +103,15 @@ def check_fields(owner, rules: dict[str, str]) -> None:
             check(f"{type(owner).__name__}.{name}", value, rule)
 
 
+def melting_problem(T_ref_K: float, T_melt_K: float) -> str | None:
+    """The homologous temperature T* = (T - T_ref) / (T_melt - T_ref) needs the melting temperature above
+    the reference one (at or below it, T* has no meaning or the wrong sign): what is wrong, or None."""
+    if not T_melt_K > T_ref_K:
+        return (f"T_melt_K ({number(T_melt_K)} K) is not above T_ref_K ({number(T_ref_K)} K); the homologous "
+                "temperature (T - T_ref) / (T_melt - T_ref) needs the melting point above the reference temperature")
+    return None
+
+
 def plate_problem(thickness_mm: float, cell_size_um: float) -> str | None:
     """A plate thinner than one cell of the mesh has no cell to compute (the hydrocode would round it up
     to one and answer for a thicker plate): what is wrong, or None."""

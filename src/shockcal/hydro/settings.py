@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
-from shockcal.hydro.rules import check_fields, plate_problem
+from shockcal.hydro.rules import check_fields, melting_problem, plate_problem
 from shockcal.hydro.state import InitialState, Material, Numerics
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
@@ -70,6 +70,9 @@ class MaterialProperties:
         check_fields(self, {"rho0_g_cc": "positive", "c1_Mbar": "positive", "c2_Mbar": "finite", "c3_Mbar": "finite",
                             "gamma0": "nonnegative", "T_ref_K": "positive", "T_melt_K": "positive",
                             "cv_J_per_kg_K": "positive", "strain_rate_ref_per_s": "positive"})
+        problem = melting_problem(self.T_ref_K, self.T_melt_K)
+        if problem:
+            raise InputError(f"MaterialProperties: {problem}")
 
     def code_units(self) -> Material:
         return Material(self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0, self.T_ref_K,
