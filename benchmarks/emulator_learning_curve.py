@@ -18,14 +18,11 @@ import argparse
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
-from scipy import stats
 
-from shockcal.emulator.study_emulator import fit_emulator
+from shockcal.emulator import fit_emulator, score_heldout
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -38,24 +35,6 @@ def ok_features(path: Path) -> pd.DataFrame:
     """The check runs' features, failed runs dropped (the training runs' are dropped by `fit_emulator`)."""
     table = pd.read_parquet(path)
     return table[table["status"] == "ok"]
-
-
-def unseen_errors(emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame], shots) -> tuple:
-    """(errors, z) of the emulator's mean at the check runs every shot has features for: (runs, 12)."""
-    runs = sorted(set.intersection(*(set(features[s]["run"]) for s in shots)))
-    rows = design.set_index("run").loc[runs]
-    mean, cov = emulator.predict({k: rows[k].to_numpy() for k in rows.columns}, shots)
-    truth = np.column_stack([features[s].set_index("run").loc[runs, f].to_numpy()
-                             for s in shots for f in CALIBRATION_FEATURES])
-    err = mean - truth
-    return err, err / np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
-
-
-def central_share(emulator, z: np.ndarray) -> float:
-    """Share of |z| inside the central 90% of the first block's error model: each feature's error is
-    t_dof(0, scale sd^2) (a Gaussian when dof is infinite)."""
-    error = emulator.blocks[0].model.error
-    return float(np.mean(np.abs(z) <= np.sqrt(error.scale) * stats.t.ppf(0.95, error.dof)))
 
 
 def main() -> None:
@@ -81,9 +60,8 @@ def main() -> None:
         start = time.perf_counter()
         emulator = fit_emulator(design.iloc[:n], {s: t[t["run"].isin(kept)] for s, t in training.items()}, spec)
         fit_s = time.perf_counter() - start
-        err, z = unseen_errors(emulator, check_design, check, shots)
-        print(f"{n:6d}{np.sqrt(np.mean(err ** 2)):10.2f}{np.mean(z ** 2):10.2f}{central_share(emulator, z):8.3f}"
-              f"{fit_s:8.1f}  ({load()})")
+        score = score_heldout(emulator, check_design, check).iloc[-1]
+        print(f"{n:6d}{score['rmse_m_s']:10.2f}{score['mean_z2']:10.2f}{score['coverage']:8.3f}{fit_s:8.1f}  ({load()})")
 
 
 if __name__ == "__main__":

@@ -97,6 +97,7 @@ def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
         scored = score_heldout(emulator, new, {"104S": exact}).iloc[-1]
         assert scored["coverage"] == coverage
         assert scored["rmse_m_s"] == pytest.approx(np.sqrt(np.mean((shift * half) ** 2)), rel=1e-12, abs=1e-12)
+        assert scored["mean_z2"] == pytest.approx(np.mean((shift * half / sd) ** 2), rel=1e-12, abs=1e-12)
     failed = new_features.assign(status=np.where(new_features["run"] < 10, "failed", "ok"))
     assert score_heldout(emulator, new, {"104S": failed})["n_values"].iloc[0] == 190
 

@@ -21,8 +21,9 @@ def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, 
     of its block's error model, t_dof(0, scale sd^2), a Gaussian when dof is infinite.
 
     Returns one row per shot and feature (`feature` "shot:name") and a last row `all (N runs)`:
-    `rmse_m_s` (root mean square of mean - simulated, m/s), `coverage` (share inside the band) and
-    `n_values`."""
+    `rmse_m_s` (root mean square of mean - simulated, m/s), `coverage` (share inside the band),
+    `mean_z2` (mean squared error over the emulator's predictive variance: 1 when its sd is honest
+    before the error model's scale) and `n_values`."""
     shots = list(features)
     ok = {s: t[t["status"] == "ok"].set_index("run") for s, t in features.items()}
     runs = sorted(set.intersection(*(set(t.index) for t in ok.values())))
@@ -37,7 +38,7 @@ def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, 
     inside = np.abs(z) <= half_width
     table = pd.DataFrame({"feature": [f"{s}:{f}" for s in shots for f in emulator.feature_names],
                           "rmse_m_s": np.sqrt(np.mean(err ** 2, axis=0)), "coverage": inside.mean(axis=0),
-                          "n_values": len(runs)})
+                          "mean_z2": np.mean(z ** 2, axis=0), "n_values": len(runs)})
     overall = {"feature": f"all ({len(runs)} runs)", "rmse_m_s": float(np.sqrt(np.mean(err ** 2))),
-               "coverage": float(inside.mean()), "n_values": inside.size}
+               "coverage": float(inside.mean()), "mean_z2": float(np.mean(z ** 2)), "n_values": inside.size}
     return pd.concat([table, pd.DataFrame([overall])], ignore_index=True)
