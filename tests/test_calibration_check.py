@@ -345,6 +345,12 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     box = small_config["inputs"]["V1"]                      # the velocity's quantiles in m/s, inside its box
     assert 1e4 * box["min"] <= summary.loc["V1_m_s", "q05"] <= summary.loc["V1_m_s", "q95"] <= 1e4 * box["max"]
 
+    for option, value, message in [("--n-live", "10", "--n-live: n_live 10: at least 50 live points"),
+                                   ("--n-eff", "20", "--n-eff: n_eff 20: at least 100")]:
+        assert main([*args, option, value]) == 2                          # refused before any sampling, in one line
+        err = capsys.readouterr().err.strip()
+        assert message in err and "\n" not in err, err
+
     monkeypatch.undo()
     old = tmp_path / "old_emulator"
     old.mkdir()
@@ -369,3 +375,25 @@ def test_check_cli_names_what_is_missing_in_the_hydrocode_truth(extra, message, 
             "105S", "--out", "never.parquet", *extra]
     assert main(argv) == 2
     assert re.search(message, capsys.readouterr().err)
+
+
+def test_every_sampler_setting_in_the_schema_has_the_librarys_minimum():
+    """One set of rules behind both doors: each n_live and n_eff the config takes (the calibration, its
+    check, the next-shot check, a sequential study's steps) has the minimum SamplerSettings refuses below."""
+    import yaml
+
+    from shockcal.inference.sampler import MIN_N_EFF, MIN_N_LIVE
+    from shockcal.study.validate import SCHEMA_PATH
+
+    found = []
+
+    def walk(node, path):
+        if isinstance(node, dict):
+            for key, value in node.items():
+                if key in ("n_live", "n_eff") and isinstance(value, dict) and "minimum" in value:
+                    found.append((f"{path}.{key}", value["minimum"], MIN_N_LIVE if key == "n_live" else MIN_N_EFF))
+                walk(value, f"{path}.{key}")
+
+    walk(yaml.safe_load(SCHEMA_PATH.read_text()), "")
+    assert len(found) >= 8, found
+    assert [f for f in found if f[1] != f[2]] == []

@@ -8,7 +8,7 @@ import pytest
 from scipy import stats
 
 from shockcal.emulator.gp import GaussianProcess
-from shockcal.emulator.heldout import score_heldout
+from shockcal.emulator.heldout import region_coverage, score_heldout
 from shockcal.emulator.study_emulator import Emulator, fit_emulator, rmse_table
 from shockcal.errors import InputError
 from shockcal.study.adapters import emulator_spec
@@ -100,6 +100,29 @@ def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
         assert scored["mean_z2"] == pytest.approx(np.mean((shift * half / sd) ** 2), rel=1e-12, abs=1e-12)
     failed = new_features.assign(status=np.where(new_features["run"] < 10, "failed", "ok"))
     assert score_heldout(emulator, new, {"104S": failed})["n_values"].iloc[0] == 190
+
+
+def test_region_coverage_is_the_share_of_runs_inside_the_error_models_region(paper_config):
+    design, features, _ = _synthetic_study(paper_config, n=90)
+    paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
+    emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
+    new, new_features, _ = _synthetic_study(paper_config, n=200, seed=9)
+    table = region_coverage(emulator, new, {"104S": new_features})
+    assert table[["block", "n_features", "n_runs"]].to_dict("records") == [
+        {"block": "104S", "n_features": 4, "n_runs": 200}]
+    assert 0.8 <= table["coverage"].iloc[0] <= 0.98                     # the region holds unseen runs
+    mean, cov = emulator.predict({k: new[k].to_numpy() for k in new.columns}, ["104S"])
+    error = emulator.blocks[0].model.error
+    limit = 4 * error.scale * stats.f.ppf(0.9, 4, error.dof)            # of e' C^-1 e, t_dof(0, scale C)
+    direction = np.linalg.cholesky(cov) @ np.full(4, 0.5)               # e' C^-1 e = 1 along it
+    for factor, inside in [(0.99, 1.0), (1.01, 0.0)]:                   # just inside or outside the region
+        exact = new_features.copy()
+        exact[CALIBRATION_FEATURES] = mean + np.sqrt(factor * limit) * direction
+        assert region_coverage(emulator, new, {"104S": exact})["coverage"].iloc[0] == inside
+    rng = np.random.default_rng(3)                                      # errors drawn from the error model itself
+    drawn = new_features.copy()
+    drawn[CALIBRATION_FEATURES] = [error.sample(m, c, rng) for m, c in zip(mean, cov)]
+    assert abs(region_coverage(emulator, new, {"104S": drawn})["coverage"].iloc[0] - 0.9) < 3 * np.sqrt(0.09 / 200)
 
 
 def test_saved_emulator_predicts_identically_and_refuses_other_versions(tmp_path, paper_config):

@@ -39,6 +39,9 @@ def test_wave_sizes_spend_the_budget(paper_config):
                                               r"design\.waves\.initial_runs \(150\)"),
     ({"criterion": "eivar"}, r"^config: design\.waves\.criterion: 'eivar' is not one of"),
     ({"widen": 0.5}, r"^config: design\.waves\.widen: 0\.5 is less than the minimum of 1"),
+    ({"stop_box": 1.5}, r"^config: design\.waves\.stop_box: 1\.5 is greater than the maximum of 1"),
+    ({"step_calibration": {"n_live": 10}},
+     r"^config: design\.waves\.step_calibration\.n_live: 10 is less than the minimum of 50"),
 ])
 def test_bad_wave_configs_are_refused_in_one_line(paper_config, waves, message):
     with pytest.raises(ConfigError, match=message) as refused:
@@ -74,6 +77,19 @@ def test_the_stopping_rule_counts_combined_monte_carlo_errors():
     exact = summary({"A": (1.0, 2.0, 3.0)}, mcse=0.0)
     assert posterior_settled(exact, exact, 3.0)
     assert not posterior_settled(exact, summary({"A": (1.0, 2.1, 3.0)}, mcse=0.0), 3.0)   # a move with no error
+
+
+def test_the_stopping_rule_lets_a_move_under_a_box_fraction_count_as_settled():
+    before = summary({"A_MPa": (100.0, 300.0, 500.0), "lambda_y": (0.5, 1.0, 2.0)}, mcse=1.0)
+    after = summary({"A_MPa": (100.0, 318.0, 500.0), "lambda_y": (0.5, 1.0, 2.0)}, mcse=1.0)   # 12.7 combined SE
+    widths = {"A_MPa": 950.0}                                           # 18 MPa is 0.019 of it
+    assert not posterior_settled(before, after, 3.0)
+    assert posterior_settled(before, after, 3.0, widths, box_fraction=0.02)
+    assert not posterior_settled(before, after, 3.0, widths, box_fraction=0.018)
+    assert posterior_settled(before, after, 0.0, widths, box_fraction=0.02)      # the box fraction alone
+    no_box = summary({"A_MPa": (100.0, 300.0, 500.0), "lambda_y": (0.5, 1.1, 2.0)}, mcse=0.01)
+    assert not posterior_settled(summary({"A_MPa": (100.0, 300.0, 500.0), "lambda_y": (0.5, 1.0, 2.0)}, mcse=0.01),
+                                 no_box, 3.0, widths, box_fraction=0.5)         # lambda_y has no box: SE alone
 
 
 def test_maximin_picks_away_from_the_runs_so_far():

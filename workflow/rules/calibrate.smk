@@ -20,7 +20,10 @@ rule calibrate:
     priority: lambda w: 10 if w.name == "joint" else 0  # the joint posterior first: a new shot's answer
     conda:
         "../envs/shockcal.yaml"
-    threads: config["emulator"]["n_jobs"]  # the emulator predicts on its n_jobs threads
+    # one core: nautilus's bounds and network training are serial (CPU 0.79 of wall time on the sequential
+    # study's calibrations); the emulator's n_jobs prediction threads take 5% of it, so calibrations run
+    # beside each other and the simulate chunks (the joint 52 s against 54.5 s with one thread: docs/workflow.md)
+    threads: 1
     params:
         settings=stage_config(config, "calibrate"),
         shots=lambda w: " ".join(SHOTS if w.name == "joint" else [w.name]),

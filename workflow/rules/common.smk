@@ -9,7 +9,7 @@ from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
 from shockcal.study.adapters import input_box, shot_mapping, study_design
 from shockcal.study.next_shot_check import plan_check
-from shockcal.study.config import wave_sizes
+from shockcal.study.config import run_cost_mm_us, wave_sizes
 from shockcal.study.simulator import simulator_kind
 from shockcal.study.stages import figure_config, stage_config
 from shockcal.study.workflow import (
@@ -86,6 +86,24 @@ def run_set_settings(stage):
 def allow_empty(wildcards):
     """`--allow-empty` for a sequential study's later wave (a stopped wave has no runs), else nothing."""
     return "--allow-empty" if wildcards.run_set in WAVES else ""
+
+
+# A run set's simulate chunks start longest first (their hydrocode cost: rows x `run_cost_mm_us`): a wave has a
+# chunk or two per shot, and with 2 cores the slowest shot's chunk starting last left a core idle for a minute
+# (docs/workflow.md, "Job order"). Priority SIMULATE_PRIORITY (the fan-out before the jobs that only read the
+# records or the design: figures, observed) up to + PRIORITY_STEPS for the run set's longest chunk, below the
+# joint calibration (10); a next-shot candidate's chunks at the base.
+SIMULATE_PRIORITY, PRIORITY_STEPS = 5, 4
+
+
+def simulate_priority(wildcards):
+    if wildcards.shot not in SHOTS:
+        return SIMULATE_PRIORITY
+    size = RUN_SET_SIZES[wildcards.run_set]
+    rows = min(CHUNK_SIZE, size - int(wildcards.chunk) * CHUNK_SIZE)
+    longest = min(CHUNK_SIZE, size) * max(run_cost_mm_us(config, shot, wildcards.run_set) for shot in SHOTS)
+    cost = rows * run_cost_mm_us(config, wildcards.shot, wildcards.run_set)
+    return SIMULATE_PRIORITY + round(PRIORITY_STEPS * cost / longest)
 
 
 def simulations(run_set, shot):

@@ -13,7 +13,7 @@ rule features_chunk:
         f"{BENCHMARKS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.tsv"
     wildcard_constraints:
         run_set="|".join(RUN_SET_SIZES),
-    priority: 5  # with its simulation chunk: the fan-out first
+    priority: 4  # after the hydrocode chunks that are ready, before figures and observed
     conda:
         "../envs/shockcal.yaml"
     params:

@@ -17,7 +17,7 @@ rule simulate:
         f"{BENCHMARKS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
     wildcard_constraints:
         run_set="|".join(RUN_SET_SIZES),
-    priority: 5  # the fan-out before the jobs that only read the records or the design (figures, observed)
+    priority: simulate_priority  # longest chunk first, before figures and observed (common.smk)
     conda:
         "../envs/shockcal.yaml"
     params:

@@ -13,6 +13,8 @@
 
 WAVE_RUN_SETS = ["training", *WAVES]  # wave 0 is the training run set
 LAST_STEP = len(WAVES)
+# a step's posterior only places the next wave: a lighter sampler (design.waves.step_calibration)
+STEP_SAMPLER = "--n-live {n_live} --n-eff {n_eff}".format(**config["design"]["waves"]["step_calibration"])
 
 
 rule merge_runs:
@@ -81,13 +83,14 @@ rule wave_calibrate:
         step=r"\d+",
     conda:
         "../envs/shockcal.yaml"
-    threads: config["emulator"]["n_jobs"]
+    threads: 1  # as the study's calibrations (calibrate.smk)
     params:
         settings=stage_config(config, "calibrate"),
+        sampler=STEP_SAMPLER,
         shots=" ".join(SHOTS),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
-        "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots}"
+        "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots} {params.sampler}"
         " --observed {input.observed} --out {output.samples} > {log} 2>&1"
 
 

@@ -31,6 +31,7 @@ def register(subparsers) -> None:
     p.add_argument("--observed", required=True, help="observed features table (CSV or Parquet: shot + feature columns)")
     p.add_argument("--out", required=True, help="posterior samples (Parquet); the summary and the weighted draws go "
                                                  "beside it as *_summary.parquet and *_weighted.parquet")
+    p.add_argument("--n-live", type=int, help="override calibration.n_live (live points)")
     p.add_argument("--n-eff", type=int, help="override calibration.n_eff (effective sample size to reach)")
     p.set_defaults(func=run)
 
@@ -75,6 +76,22 @@ def study_emulator(directory, config: dict):
     return emulator
 
 
+def sampler_overrides(settings, n_live: int | None, n_eff: int | None, draws_follow_n_eff: bool = False):
+    """`settings` (CalibrationSettings) with the command line's --n-live and --n-eff (None: the config's;
+    `draws_follow_n_eff`: keep n_eff draws too); InputError naming the option the sampler refuses."""
+    from shockcal.errors import InputError
+
+    for option, changes in (("--n-live", {"n_live": n_live}),
+                            ("--n-eff", {"n_eff": n_eff, **({"draws": n_eff} if draws_follow_n_eff else {})})):
+        if None in changes.values():
+            continue
+        try:
+            settings = settings.with_sampler(**changes)
+        except ValueError as exc:
+            raise InputError(f"{option}: {exc}") from None
+    return settings
+
+
 def run(args) -> int:
     import logging
 
@@ -88,9 +105,7 @@ def run(args) -> int:
     unique_shots(args.shots)
     emulator = study_emulator(args.emulator, config)
     observed = read_table(args.observed)
-    settings = calibration_settings(config, args.shots)
-    if args.n_eff is not None:
-        settings = settings.with_sampler(n_eff=args.n_eff)
+    settings = sampler_overrides(calibration_settings(config, args.shots), args.n_live, args.n_eff)
     posterior = calibrate(emulator, args.shots, observed, settings, source=args.observed)
     info = write_posterior(posterior, args.out)
     logging.getLogger("shockcal.calibrate").info(
@@ -125,11 +140,8 @@ def run_check(args) -> int:
     except ValueError as exc:
         raise InputError(f"--seed-stream: {exc}") from None
     draws = [] if args.draws_out else None
-    settings = calibration_settings(config, args.shots, check=True)
-    if args.n_live is not None:
-        settings = settings.with_sampler(n_live=args.n_live)
-    if args.n_eff is not None:
-        settings = settings.with_sampler(n_eff=args.n_eff, draws=args.n_eff)
+    settings = sampler_overrides(calibration_settings(config, args.shots, check=True), args.n_live, args.n_eff,
+                                 draws_follow_n_eff=True)
     table = synthetic_truth(emulator, args.shots, settings, trials, seed=seed, truths=truths, draws=draws)
     source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})

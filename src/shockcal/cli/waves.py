@@ -56,7 +56,7 @@ def run_wave_design(args) -> int:
     from shockcal.io import read_table, write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import load_study_design
-    from shockcal.study.config import prior_bounds, wave_sizes
+    from shockcal.study.config import prior_bounds, user_box_widths, wave_sizes
     from shockcal.study.stages import load_stage_config
 
     log = logging.getLogger("shockcal.design.waves")
@@ -74,8 +74,9 @@ def run_wave_design(args) -> int:
         shifts = quantile_shifts(before, after)
         log.info("joint posterior's 5/50/95%% points moved (combined Monte Carlo SE):\n%s",
                  shifts.to_string(index=False, float_format="%.2f"))
-        if posterior_settled(before, after, waves["stop_mcse"]):
-            stopped = f"no 5/50/95% point moved by {waves['stop_mcse']:g} combined Monte Carlo SE (design.waves.stop_mcse)"
+        if posterior_settled(before, after, waves["stop_mcse"], user_box_widths(config), waves["stop_box"]):
+            stopped = (f"no 5/50/95% point moved by max({waves['stop_mcse']:g} combined Monte Carlo SE, "
+                       f"{waves['stop_box']:g} of its box) or more (design.waves.stop_mcse, stop_box)")
     runs = load_study_design(args.runs, config)
     variance = None
     if waves["criterion"] == "max_variance" and not stopped:

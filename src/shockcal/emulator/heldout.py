@@ -1,6 +1,7 @@
 """An emulator scored on hydrocode runs it was not fitted on: the error of its mean and whether its error
-model's central band holds them (what a K-fold on the training design cannot say where the design is
-crowded into the posterior; docs/sequential.md)."""
+model holds them, feature by feature (`score_heldout`) and as the 12-feature vector the calibration's
+likelihood reads (`region_coverage`). A K-fold on the training design cannot say this where the design is
+crowded into the posterior (docs/sequential.md)."""
 
 from __future__ import annotations
 
@@ -24,13 +25,7 @@ def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, 
     `rmse_m_s` (root mean square of mean - simulated, m/s), `coverage` (share inside the band),
     `mean_z2` (mean squared error over the emulator's predictive variance: 1 when its sd is honest
     before the error model's scale) and `n_values`."""
-    shots = list(features)
-    ok = {s: t[t["status"] == "ok"].set_index("run") for s, t in features.items()}
-    runs = sorted(set.intersection(*(set(t.index) for t in ok.values())))
-    rows = design.set_index("run").loc[runs]
-    mean, cov = emulator.predict({k: rows[k].to_numpy() for k in rows.columns}, shots)
-    truth = np.column_stack([ok[s].loc[runs, f].to_numpy(float) for s in shots for f in emulator.feature_names])
-    err = mean - truth
+    shots, runs, err, cov = _heldout_errors(emulator, design, features)
     z = err / np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
     half_width = np.empty(err.shape[1])
     for columns, error in emulator.error_groups(shots):
@@ -42,3 +37,39 @@ def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, 
     overall = {"feature": f"all ({len(runs)} runs)", "rmse_m_s": float(np.sqrt(np.mean(err ** 2))),
                "coverage": float(inside.mean()), "mean_z2": float(np.mean(z ** 2)), "n_values": inside.size}
     return pd.concat([table, pd.DataFrame([overall])], ignore_index=True)
+
+
+def region_coverage(emulator: Emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame],
+                    level: float = 0.9) -> pd.DataFrame:
+    """Whether the error model holds held-out runs as a vector: the share of runs whose errors e over a
+    block's features lie in its central `level` region, e' C^-1 e / (F scale) <= the F(F, dof) distribution's
+    `level` quantile (the region of t_dof(0, scale C) for the emulator covariance C; chi-square / F for a
+    Gaussian). This is the density the calibration's likelihood uses; a feature's band (`score_heldout`)
+    is one margin of it. Arguments as `score_heldout`.
+
+    Returns one row per error block (`block`: its features' shots, e.g. "104S+105S+106S"): `n_features`,
+    `coverage`, `n_runs`."""
+    shots, runs, err, cov = _heldout_errors(emulator, design, features)
+    rows = []
+    for columns, error in emulator.error_groups(shots):
+        e, c = err[:, columns], cov[:, columns][:, :, columns]
+        d2 = np.einsum("ni,ni->n", e, np.linalg.solve(c, e[..., None])[..., 0])
+        f = len(columns)
+        limit = f * error.scale * (stats.chi2.ppf(level, f) / f if np.isinf(error.dof) else
+                                   stats.f.ppf(level, f, error.dof))
+        block = [s for i, s in enumerate(shots) if any(j // len(emulator.feature_names) == i for j in columns)]
+        rows.append({"block": "+".join(block), "n_features": f, "coverage": float(np.mean(d2 <= limit)),
+                     "n_runs": len(runs)})
+    return pd.DataFrame(rows)
+
+
+def _heldout_errors(emulator: Emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame]):
+    """The shots, the runs "ok" for every shot, and the emulator's errors (runs, F) = mean - simulated and
+    covariances (runs, F, F) there, features shot after shot."""
+    shots = list(features)
+    ok = {s: t[t["status"] == "ok"].set_index("run") for s, t in features.items()}
+    runs = sorted(set.intersection(*(set(t.index) for t in ok.values())))
+    rows = design.set_index("run").loc[runs]
+    mean, cov = emulator.predict({k: rows[k].to_numpy() for k in rows.columns}, shots)
+    truth = np.column_stack([ok[s].loc[runs, f].to_numpy(float) for s in shots for f in emulator.feature_names])
+    return shots, runs, mean - truth, cov

@@ -172,6 +172,10 @@ def log_volume_variance(bound) -> float:
     return total
 
 
+MIN_N_LIVE = 50          # the config schema's minimum of every n_live (calibration, its check, the next-shot check)
+MIN_N_EFF = 100          # and of every n_eff
+
+
 @dataclass(frozen=True)
 class SamplerSettings:
     """How nautilus samples a posterior.
@@ -199,6 +203,11 @@ class SamplerSettings:
     replicates: int = 1
 
     def __post_init__(self):
+        if self.n_live < MIN_N_LIVE:
+            raise ValueError(f"n_live {self.n_live}: at least {MIN_N_LIVE} live points")
+        if self.n_eff < MIN_N_EFF:
+            raise ValueError(f"n_eff {self.n_eff}: at least {MIN_N_EFF} (an effective sample size below it leaves "
+                             f"the 5% and 95% points to a handful of draws)")
         if self.replicates < 1 or self.replicates == 2:
             raise ValueError(f"replicates {self.replicates}: 1, or at least 3 (a spread needs three runs)")
 

@@ -65,25 +65,40 @@ def weighted_quantiles(x: np.ndarray, w: np.ndarray, q) -> np.ndarray:
     return np.interp(q, cdf / w.sum(), x[order])
 
 
+def quantile_moves(before: pd.DataFrame, after: pd.DataFrame) -> tuple[pd.Series, np.ndarray, np.ndarray]:
+    """How far each parameter's 5/50/95% points moved between two posterior summaries (`summarize`): the
+    parameters of both, then |q_after - q_before| and the combined Monte Carlo SE
+    sqrt(mcse_before^2 + mcse_after^2), each (parameters, quantiles) in the summaries' units."""
+    both = before.merge(after, on="parameter", suffixes=("_before", "_after"))
+    columns = [f"q{round(100 * p):02d}" for p in SUMMARY_QUANTILES]
+    moved = np.column_stack([np.abs(both[f"{q}_after"] - both[f"{q}_before"]) for q in columns])
+    combined = np.column_stack([np.hypot(both[f"{q}_mcse_before"], both[f"{q}_mcse_after"]) for q in columns])
+    return both["parameter"], moved, combined
+
+
 def quantile_shifts(before: pd.DataFrame, after: pd.DataFrame) -> pd.DataFrame:
     """How far each parameter's 5/50/95% points moved between two posterior summaries (`summarize`), in
     combined Monte Carlo standard errors: |q_after - q_before| / sqrt(mcse_before^2 + mcse_after^2).
     One row per parameter of both (column `parameter`), one column per quantile (q05, q50, q95)."""
-    both = before.merge(after, on="parameter", suffixes=("_before", "_after"))
-    shifts = {"parameter": both["parameter"]}
-    for p in SUMMARY_QUANTILES:
-        q = f"q{round(100 * p):02d}"
-        combined = np.hypot(both[f"{q}_mcse_before"], both[f"{q}_mcse_after"])
-        moved = np.abs(both[f"{q}_after"] - both[f"{q}_before"]).to_numpy()
-        with np.errstate(divide="ignore", invalid="ignore"):    # no error and no move: 0; a move without error: inf
-            shifts[q] = np.where(combined > 0, moved / combined, np.where(moved > 0, np.inf, 0.0))
-    return pd.DataFrame(shifts)
+    parameters, moved, combined = quantile_moves(before, after)
+    with np.errstate(divide="ignore", invalid="ignore"):    # no error and no move: 0; a move without error: inf
+        shifts = np.where(combined > 0, moved / combined, np.where(moved > 0, np.inf, 0.0))
+    return pd.DataFrame({"parameter": parameters,
+                         **{f"q{round(100 * p):02d}": shifts[:, j] for j, p in enumerate(SUMMARY_QUANTILES)}})
 
 
-def posterior_settled(before: pd.DataFrame, after: pd.DataFrame, threshold: float) -> bool:
+def posterior_settled(before: pd.DataFrame, after: pd.DataFrame, threshold: float,
+                      box_widths: dict[str, float] | None = None, box_fraction: float = 0.0) -> bool:
     """The stopping rule of a sequential study: no 5/50/95% point of any parameter moved by `threshold`
-    combined Monte Carlo standard errors or more (`quantile_shifts`); a threshold of 0 never settles."""
-    if threshold <= 0:
+    combined Monte Carlo standard errors or more, except a point that moved by less than `box_fraction`
+    of its parameter's box width (`box_widths`: summary parameter name -> width in the summaries' units;
+    a parameter without one is held to the Monte Carlo SE alone). With a threshold of 0 any move counts
+    but one under the box fraction; both 0 never settle."""
+    if threshold <= 0 and box_fraction <= 0:
         return False
-    shifts = quantile_shifts(before, after)
-    return bool((shifts.drop(columns="parameter").to_numpy() < threshold).all())
+    parameters, moved, combined = quantile_moves(before, after)
+    still = (moved > 0) & (moved >= threshold * combined)
+    if box_fraction > 0:
+        width = parameters.map(box_widths or {}).to_numpy(float)[:, None]      # NaN: no box, never settled by it
+        still &= ~(moved < box_fraction * width)
+    return not still.any()

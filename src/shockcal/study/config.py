@@ -62,6 +62,23 @@ def input_columns(config: dict) -> dict[str, tuple[str, str, float]]:
     return user_columns({name: box["unit"] for name, box in config["inputs"].items()}, input_user_units(config))
 
 
+def user_box_widths(config: dict) -> dict[str, float]:
+    """Each input's box width in its user unit, keyed by its name for a user (A_MPa, V1_m_s: the names of
+    the posterior summaries)."""
+    columns = input_columns(config)
+    return {columns[name][0]: (high - low) * columns[name][2] for name, (low, high) in prior_bounds(config).items()}
+
+
+def run_cost_mm_us(config: dict, shot: str, run_set: str = "training") -> float:
+    """One hydrocode run of `shot`'s cost up to a factor common to the study's shots, to start the longest
+    jobs first: its cells (the plates' total thickness, mm) times its simulated time (us; the predictive
+    runs' `predict.end_time_us`, others `end_time_us`). The time step is set by the cell size and the sound
+    speed, alike for every shot of one material."""
+    shot_section = shot_config(config, shot)
+    end = config["predict"]["end_time_us"] if run_set == "predict" else end_time_us(config, shot_section)
+    return (shot_section["flyer_mm"] + shot_section["target_mm"]) * end
+
+
 def velocity_box_m_s(config: dict, shot: str) -> tuple[float, float] | None:
     """The impact-velocity box of `shot` in m/s (its `velocity_input`'s box, converted from the input's
     unit), or None when that unit is not a velocity unit shockcal knows (`VELOCITY_TO_M_S`)."""
