@@ -40,3 +40,9 @@ def test_report_tables_from_posteriors_cv_coverage_and_sobol(tmp_path):
     coverage = pd.read_csv(out / "coverage.csv")
     assert list(coverage["parameter"]) == ["A", "B"] and (coverage["truth"] == "emulator").all()
     assert "<table" in (out / "sobol.html").read_text() and "-45.25" in (out / "evidence.html").read_text()
+
+
+def test_heldout_options_go_together_in_one_line(tmp_path, capsys):
+    assert main(["report-tables", "--heldout-emulator", str(tmp_path), "--out-dir", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("--heldout-emulator, --heldout-design and --heldout-features go together") and "\n" not in err

@@ -111,3 +111,18 @@ def test_readme_arviz_block_runs_as_written(quick_study, tmp_path, monkeypatch):
     scope: dict = {}
     exec(compile(code, "README.md", "exec"), scope)
     assert list(scope["summary"].index)[:2] == ["A_MPa", "B_MPa"]
+
+
+def test_the_report_scores_the_emulator_on_the_posteriors_predictive_runs(quick_study):
+    """report/emulator_heldout.csv: every feature of every shot, the overall row and the 12-feature region,
+    on the predictive runs (no fit saw them); the overall RMSE is the root mean square of the per-feature ones."""
+    results, _ = quick_study
+    table = pd.read_csv(results / "report" / "emulator_heldout.csv")
+    runs = len(pd.read_parquet(results / "predict" / "design.parquet"))
+    features = table[table["feature"].str.contains(":")]
+    assert len(features) == 12 and (features["n_values"] == runs).all()
+    overall = table[table["feature"] == f"all ({runs} runs)"].iloc[0]
+    assert overall["rmse_m_s"] == pytest.approx(np.sqrt(np.mean(features["rmse_m_s"] ** 2)), rel=1e-9)
+    region = table[table["feature"] == "region: 104S+105S+106S (12 features)"].iloc[0]
+    assert region["n_values"] == runs and 0 <= region["coverage"] <= 1
+    assert (results / "report" / "emulator_heldout.html").is_file()

@@ -1,6 +1,6 @@
 # The report's tables (snakemake --report shows HTML inline; each table also as CSV beside it): posterior
-# summaries, evidence, cross-validation, the Sobol indices, and the synthetic-truth coverage when `make check`
-# has made it.
+# summaries, evidence, cross-validation, the Sobol indices, the emulator on the posterior's predictive runs,
+# and the synthetic-truth coverage when `make check` has made it.
 
 
 rule report_tables:
@@ -54,7 +54,35 @@ rule report_coverage:
         "shockcal report-tables --coverage {params.coverage} --out-dir {params.out_dir} > {log} 2>&1"
 
 
+rule report_heldout:
+    """The study's emulator on the posterior's predictive runs, which no fit saw: where the calibration uses it."""
+    input:
+        emulator=rules.emulator.output.emulator,
+        design=run_set_path("predict", "design.parquet"),
+        features=expand(rules.features.output[0], run_set="predict", shot=SHOTS),
+    output:
+        report(
+            f"{RESULTS}/report/emulator_heldout.html",
+            caption="../report/emulator_heldout.rst",
+            category="3 emulator",
+        ),
+        f"{RESULTS}/report/emulator_heldout.csv",
+    log:
+        f"{LOGS}/report_heldout.log",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+        pairs=lambda w, input: pairs(SHOTS, input.features),
+        out_dir=lambda w, output: os.path.dirname(output[0]),
+    shell:
+        "shockcal report-tables --heldout-emulator {params.emulator_dir} --heldout-design {input.design}"
+        " --heldout-features {params.pairs} --out-dir {params.out_dir} > {log} 2>&1"
+
+
 ALL_TARGETS.extend(rules.report_tables.output)
+if not ARCHIVE_STUDY:  # an archive study runs no predictive runs
+    ALL_TARGETS.extend(rules.report_heldout.output)
 # the coverage checks are outside `all` (make check); their table joins the report once they exist
 if all(os.path.exists(path) for path in CHECK_TARGETS):
     ALL_TARGETS.extend(rules.report_coverage.output)

@@ -6,8 +6,11 @@ From the posteriors (`shockcal calibrate` output and its metadata) it writes `po
 unit in the parameter's name and the `unit` column) and `evidence.csv` (log evidence with its sd, Kish ESS, likelihood evaluations per
 calibration); from the emulator's `cv_rmse.csv`, `cross_validation.csv`; from the synthetic-truth
 checks' merged tables (`make check`), `coverage.csv` (per truth and parameter); from the Sobol table
-(`shockcal sensitivity`), `sobol.html` only (its CSV is the sensitivity stage's). Each table is written
-only when its inputs are given. No config is read.
+(`shockcal sensitivity`), `sobol.html` only (its CSV is the sensitivity stage's); from the emulator and
+hydrocode runs it never saw (the posterior's predictive runs), `emulator_heldout.csv` (RMSE and the share
+inside each feature's 90% band, then the share of runs inside its error model's 90% region of the feature
+vector: `shockcal.emulator.score_heldout`, `region_coverage`). Each table is written only when its inputs
+are given. No config is read.
 """
 
 from __future__ import annotations
@@ -29,6 +32,11 @@ def register(subparsers) -> None:
     p.add_argument("--coverage", nargs="+", default=[], metavar="TRUTH=TABLE",
                    help="merged synthetic-truth tables (shockcal coverage --out) by truth")
     p.add_argument("--sobol", help="the Sobol table (shockcal sensitivity --out)")
+    p.add_argument("--heldout-emulator", help="an emulator directory, scored on --heldout-design's runs")
+    p.add_argument("--heldout-design", help="design table of hydrocode runs the emulator never saw (e.g. the "
+                                            "posterior's predictive runs, results/predict/design.parquet)")
+    p.add_argument("--heldout-features", nargs="+", default=[], metavar="SHOT=TABLE",
+                   help="those runs' features per shot (shockcal features --out)")
     p.add_argument("--out-dir", required=True, help="folder for the tables (NAME.csv and NAME.html)")
     p.set_defaults(func=run)
 
@@ -91,5 +99,31 @@ def run(args) -> int:
     if args.sobol:
         written += _write(read_table(args.sobol), out, "sobol", "Sobol indices of the emulated features "
                           "(95% bootstrap half-widths)", csv=False)
+    if args.heldout_emulator or args.heldout_design or args.heldout_features:
+        written += _write(heldout_table(args), out, "emulator_heldout",
+                          "The emulator on hydrocode runs no fit saw (m/s): 90% band per feature, 90% region per "
+                          "feature vector")
     logging.getLogger("shockcal.report").info("wrote %s in %s", ", ".join(written) or "nothing", out)
     return 0
+
+
+def heldout_table(args):
+    """`score_heldout`'s rows (per feature, then all), then one row per error block with the share of runs in
+    its 90% region (`feature` "region: SHOTS (F features)", `coverage`, `n_values` = runs)."""
+    import pandas as pd
+
+    from shockcal.emulator import Emulator, region_coverage, score_heldout
+    from shockcal.errors import InputError
+    from shockcal.io import read_table
+
+    if not (args.heldout_emulator and args.heldout_design and args.heldout_features):
+        raise InputError("report-tables: --heldout-emulator, --heldout-design and --heldout-features go together")
+    emulator = Emulator.load(args.heldout_emulator)
+    design = read_table(args.heldout_design)
+    features = {shot: read_table(path)
+                for shot, path in parse_pairs(args.heldout_features, "--heldout-features").items()}
+    regions = region_coverage(emulator, design, features)
+    region_rows = pd.DataFrame({"feature": [f"region: {b} ({f} features)" for b, f in
+                                            zip(regions["block"], regions["n_features"])],
+                                "coverage": regions["coverage"], "n_values": regions["n_runs"]})
+    return pd.concat([score_heldout(emulator, design, features), region_rows], ignore_index=True)
