@@ -1,6 +1,7 @@
 """The rerun check of `make test-slurm` (tests/slurm/slurm_study.py), on snakemake logs: after a cancelled
 training chunk, the predict run set's simulate and features jobs rerun too (they were never made) and
-are not counted as the cancelled chunk; the check run set's must not rerun."""
+are not counted as the cancelled chunk, nor are a sequential study's later waves; the check run set's
+must not rerun."""
 
 from __future__ import annotations
 
@@ -30,6 +31,7 @@ CANCELLED = [_job("simulate", 1, run_set="training", shot="105S", chunk="2"),
 PREDICT = [_job("simulate", 10 + i, run_set="predict", shot=s, chunk="0") for i, s in enumerate(["104S", "105S"])]
 PREDICT += [_job("features_chunk", 20 + i, run_set="predict", shot=s, chunk="0") for i, s in enumerate(["104S", "105S"])]
 PREDICT += [_job("features", 30 + i, run_set="predict", shot=s) for i, s in enumerate(["104S", "105S"])]
+PER_CHUNK = ("simulate", "features_chunk", "features")
 
 
 def test_jobs_are_read_with_their_wildcards_once():
@@ -68,3 +70,18 @@ def test_a_cancelled_predict_chunk_allows_nothing_elsewhere():
     assert slurm_study.rerun_problems(slurm_study.scheduled_jobs(_log(*CANCELLED, *PREDICT[:1], PREDICT[2],
                                                                       PREDICT[4])), "predict", "104S", "0")[0] == (
         "run 2 scheduled 1 simulate jobs in run set training, which run 1 had finished")
+
+
+def test_a_sequential_studys_later_waves_are_made_from_the_cancelled_chunk():
+    waves = [_job(rule, 50 + 10 * k + i, run_set=f"wave{k}", shot=s, **({} if rule == "features" else {"chunk": "0"}))
+             for k in (1, 2) for i, (rule, s) in enumerate((r, s) for r in PER_CHUNK for s in ("104S", "105S"))]
+    jobs = slurm_study.scheduled_jobs(_log(*CANCELLED, *waves, *PREDICT))
+    assert slurm_study.rerun_problems(jobs, "training", "105S", "2") == []
+    wave1_cancelled = [_job("simulate", 90, run_set="wave1", shot="105S", chunk="0"),
+                       _job("features_chunk", 91, run_set="wave1", shot="105S", chunk="0"),
+                       _job("features", 92, run_set="wave1", shot="105S")]
+    later = slurm_study.scheduled_jobs(_log(*wave1_cancelled, *waves[6:], *PREDICT))       # wave 2's jobs
+    assert slurm_study.rerun_problems(later, "wave1", "105S", "0") == []
+    earlier = slurm_study.scheduled_jobs(_log(*wave1_cancelled, CANCELLED[0]))               # a training chunk
+    assert slurm_study.rerun_problems(earlier, "wave1", "105S", "0") == [
+        "run 2 scheduled 1 simulate jobs in run set training, which run 1 had finished"]

@@ -232,17 +232,28 @@ def scheduled_jobs(text: str) -> list[tuple[str, dict[str, str]]]:
     return jobs
 
 
-# Run sets made from another's results: a cancelled chunk of the key leaves every job of these unmade
-# in run 1 (the predict design is drawn from the calibration on the training run set).
-DOWNSTREAM_RUN_SETS = {"training": {"predict"}, "predict": set(), "check": set()}
 PER_CHUNK_RULES = ("simulate", "features_chunk", "features")
+
+
+def made_from(run_set: str, other: str) -> bool:
+    """Whether run set `other` is made from `run_set`'s results, so that a cancelled chunk of `run_set`
+    leaves every job of `other` unmade in run 1: the predict design is drawn from the joint posterior of
+    the training runs and every wave; a sequential study's wave k (wave1, wave2, ...) from the runs of
+    waves 0..k-1 (wave 0 is the training run set)."""
+    def wave(name: str) -> int | None:
+        later = re.fullmatch(r"wave(\d+)", name)
+        return 0 if name == "training" else int(later.group(1)) if later else None
+
+    if wave(run_set) is None:
+        return False
+    return other == "predict" or (wave(other) is not None and wave(other) > wave(run_set))
 
 
 def rerun_problems(jobs: list[tuple[str, dict[str, str]]], run_set: str, shot: str, chunk: str) -> list[str]:
     """What is wrong with run 2's schedule after chunk `chunk` of `shot` in `run_set` was cancelled for
     good in run 1, rule by rule of PER_CHUNK_RULES and run set by run set: in the cancelled run set,
     exactly that chunk (simulate, features_chunk) and that shot's merge (features); in the run sets
-    made from it (DOWNSTREAM_RUN_SETS, never made in run 1), any; in the others (finished), none."""
+    made from it (`made_from`, never made in run 1), any; in the others (finished), none."""
     problems = []
     for rule in PER_CHUNK_RULES:
         by_set: dict[str, list] = {}
@@ -256,7 +267,7 @@ def rerun_problems(jobs: list[tuple[str, dict[str, str]]], run_set: str, shot: s
             problems.append(f"run 2 scheduled {rule} jobs {got} (shot, chunk) in run set {run_set}, expected "
                             f"{expected} (the cancelled chunk)")
         for other, found in sorted(by_set.items()):
-            if other not in DOWNSTREAM_RUN_SETS.get(run_set, set()):
+            if not made_from(run_set, other):
                 problems.append(f"run 2 scheduled {len(found)} {rule} jobs in run set {other}, which run 1 had "
                                 "finished")
     return problems
