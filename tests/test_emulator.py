@@ -79,11 +79,17 @@ def test_emulator_predicts_a_known_map_and_its_bands_hold(paper_config):
     assert np.all(np.linalg.eigvalsh(cov) > 0)
 
 
-def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
+def _fitted_and_unseen(paper_config):
+    """A per-shot emulator of the known map on 90 runs, and 200 runs it never saw (design, features)."""
     design, features, _ = _synthetic_study(paper_config, n=90)
     paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
     emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
     new, new_features, _ = _synthetic_study(paper_config, n=200, seed=9)
+    return emulator, new, new_features
+
+
+def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
+    emulator, new, new_features = _fitted_and_unseen(paper_config)
     table = score_heldout(emulator, new, {"104S": new_features})
     assert list(table["feature"]) == [f"104S:{f}" for f in CALIBRATION_FEATURES] + ["all (200 runs)"]
     assert table["rmse_m_s"].iloc[-1] < 4 * NOISE and 0.8 <= table["coverage"].iloc[-1] <= 0.98   # the bands hold
@@ -103,10 +109,7 @@ def test_heldout_score_is_the_error_and_band_share_at_unseen_runs(paper_config):
 
 
 def test_region_coverage_is_the_share_of_runs_inside_the_error_models_region(paper_config):
-    design, features, _ = _synthetic_study(paper_config, n=90)
-    paper_config["emulator"].update(structure="per_shot", n_starts=2, cv_folds=5)
-    emulator = fit_emulator(design, {"104S": features}, emulator_spec(paper_config, ["104S"]))
-    new, new_features, _ = _synthetic_study(paper_config, n=200, seed=9)
+    emulator, new, new_features = _fitted_and_unseen(paper_config)
     table = region_coverage(emulator, new, {"104S": new_features})
     assert table[["block", "n_features", "n_runs"]].to_dict("records") == [
         {"block": "104S", "n_features": 4, "n_runs": 200}]
