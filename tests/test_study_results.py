@@ -119,10 +119,11 @@ def test_the_report_scores_the_emulator_on_the_posteriors_predictive_runs(quick_
     results, _ = quick_study
     table = pd.read_csv(results / "report" / "emulator_heldout.csv")
     runs = len(pd.read_parquet(results / "predict" / "design.parquet"))
-    features = table[table["feature"].str.contains(":")]
+    features = table[~table["feature"].str.startswith(("all (", "region: "))]
     assert len(features) == 12 and (features["n_values"] == runs).all()
     overall = table[table["feature"] == f"all ({runs} runs)"].iloc[0]
-    assert overall["rmse_m_s"] == pytest.approx(np.sqrt(np.mean(features["rmse_m_s"] ** 2)), rel=1e-9)
+    # the CSV keeps 6 significant digits
+    assert overall["rmse_m_s"] == pytest.approx(np.sqrt(np.mean(features["rmse_m_s"] ** 2)), rel=1e-5)
     region = table[table["feature"] == "region: 104S+105S+106S (12 features)"].iloc[0]
     assert region["n_values"] == runs and 0 <= region["coverage"] <= 1
     assert (results / "report" / "emulator_heldout.html").is_file()
