@@ -57,7 +57,7 @@ def region_coverage(emulator: Emulator, design: pd.DataFrame, features: dict[str
         f = len(columns)
         limit = f * error.scale * (stats.chi2.ppf(level, f) / f if np.isinf(error.dof) else
                                    stats.f.ppf(level, f, error.dof))
-        block = [s for i, s in enumerate(shots) if any(j // len(emulator.feature_names) == i for j in columns)]
+        block = dict.fromkeys(shots[j // len(emulator.feature_names)] for j in columns)     # its shots, in order
         rows.append({"block": "+".join(block), "n_features": f, "coverage": float(np.mean(d2 <= limit)),
                      "n_runs": len(runs)})
     return pd.DataFrame(rows)
