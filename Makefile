@@ -79,7 +79,7 @@ models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into res
 
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
 	$(call snakemake,results) --cores $(CORES) check
-	@echo "results: $(CURDIR)/results/posterior/coverage_emulator.parquet and coverage_hydrocode.parquet"
+	@echo "results: $(CURDIR)/results/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
 	@echo "report:  their table joins $(CURDIR)/results/report.html at the next make study"
 
 next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain

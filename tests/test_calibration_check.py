@@ -301,6 +301,24 @@ def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
     assert draws[0][1].shape == (4,)
 
 
+def test_design_truths_without_features_draw_them_from_the_emulator(small_config):
+    """A truth design alone: each trial's truth is its row's inputs and lambda_y, its features the
+    emulator's draw there (so its check differs from the hydrocode truths' only by the emulator)."""
+    emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
+    truths, theta = _toy_hydro_truths(emu, small_config, n_runs=6)
+    design = truths.design.assign(lambda_y=np.linspace(0.5, 1.5, 6)).sample(frac=1.0, random_state=1)
+    alone = HydroTruths(design, None)
+    rows = alone.table(["A", "n"], ["toy"])
+    assert [row.run for row in rows] == list(range(6)) and all(row.features is None for row in rows)
+    np.testing.assert_array_equal(rows[4].theta, theta[4])
+    trials = synthetic_truth(emu, ["toy"], _settings(small_config, 100, 300), trials=range(2, 4), seed=4, truths=alone)
+    table = trials.set_index(["trial", "parameter"])
+    assert (trials["status"] == "ok").all() and list(trials["run"].unique()) == [2, 3]
+    assert table.loc[(3, "A"), "truth"] == theta[3, 0] and table.loc[(3, "lambda_y"), "truth"] == pytest.approx(1.1)
+    with pytest.raises(InputError, match="truth design"):
+        HydroTruths(design.drop(columns="n"), None).table(["A", "n"], ["toy"])
+
+
 @pytest.mark.slow
 def test_hydro_truth_coverage_is_near_nominal(small_config):
     emu = ShotEmulator(small_config, shots=["toy"], emulator_sd=0.3)
@@ -361,7 +379,8 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--truth-design", "d.csv"], "--truth-design and --truth-features go together"),
+    (["--truth-features", "104S=f.csv"], "--truth-features needs --truth-design"),
+    (["--truth-design", "no-such.csv"], "table no-such.csv does not exist"),
     (["--truth-design", "d.csv", "--truth-features", "104S=f.csv"], r"no --truth-features for shot\(s\) \['105S'\]"),
 ])
 def test_check_cli_names_what_is_missing_in_the_hydrocode_truth(extra, message, monkeypatch, capsys):

@@ -23,7 +23,7 @@ def _posterior(config, n):
     lo = np.array([config["inputs"][k]["min"] for k in names])
     hi = np.array([config["inputs"][k]["max"] for k in names])
     table = pd.DataFrame(lo + rng.random((n, len(names))) * (hi - lo), columns=names)
-    return table.assign(lambda_y=1.0, log_post=0.0, chain=rng.integers(0, 4, n))
+    return table.assign(lambda_y=rng.gamma(5.0, 0.2, n), log_post=0.0, chain=rng.integers(0, 4, n))
 
 
 def test_draws_are_posterior_rows_shaped_like_a_design(paper_config):
@@ -54,10 +54,20 @@ def test_cli_writes_the_design(paper_config, tmp_path, capsys):
     out = tmp_path / "design.parquet"
     assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(out),
                  "--n-runs", "20"]) == 0
-    assert len(read_table(out)) == 20
+    design = read_table(out)
+    assert len(design) == 20 and list(design.columns) == ["run", *input_names(paper_config), "lambda_y"]
+    drawn = design.merge(_posterior(paper_config, 200), on=input_names(paper_config), suffixes=("", "_posterior"))
+    assert len(drawn) == 20 and (drawn["lambda_y"] == drawn["lambda_y_posterior"]).all()   # each draw's own
+    other = tmp_path / "check.parquet"
+    assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(other),
+                 "--n-runs", "20", "--stream", "check_posterior"]) == 0
+    assert not read_table(other).equals(design)                 # the check's truths: a stream of their own
     assert main(["predict", "--config", CONFIG, "--posterior", str(tmp_path / "nope.parquet"),
                  "--out", str(out)]) == 2
     assert "nope.parquet does not exist" in capsys.readouterr().err
+    assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(out),
+                 "--stream", "nope"]) == 2
+    assert "--stream: unknown random stream 'nope'" in capsys.readouterr().err
 
 
 class _LinearEmulator:

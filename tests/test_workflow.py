@@ -238,10 +238,14 @@ def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_pat
 
 
 def test_coverage_checks_fan_out_in_batches_of_trials(study):
-    # quick.yaml: 4 trials per check, 2 per job -> 2 batch jobs per truth, one merge each
+    # quick.yaml: 4 trials per check, 2 per job -> 2 batch jobs per truth (emulator, hydrocode, posterior), one merge
+    # each; the hydrocode truths' runs over the box and the posterior truths' runs from the joint posterior, no
+    # training run and no refit
     jobs = pending_jobs(study[1], target="check")
-    assert jobs["calibration_check_batch"] == 4 and jobs["coverage"] == 2, jobs
-    assert "emulator" not in jobs and "simulate" not in jobs, jobs
+    assert jobs["calibration_check_batch"] == 6 and jobs["coverage"] == 3, jobs
+    assert jobs["check_design"] == jobs["check_posterior_design"] == 1, jobs
+    assert jobs["simulate[check]"] == jobs["simulate[check_posterior]"] == 3, jobs
+    assert "emulator" not in jobs and "simulate" not in jobs and "calibrate" not in jobs, jobs
 
 
 def test_deleted_intermediates_rerun_only_their_dependents(study):

@@ -21,6 +21,7 @@ keyed further (an emulator block index, a calibration's shots).
 | next_shot | candidates' draws ("draws"), gains ("eig", name); the check's truths ("check_truths"), noise ("check_noise") |
 | replicate | a calibration's runs after its first (`calibration.replicates`), keyed by run, rooted at the calibration's seed |
 | waves | a sequential study's later waves: the posterior pool of wave k ("pool", k) |
+| check_posterior | the joint-posterior draws the posterior-truth check takes as truths (`shockcal predict --stream`) |
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ import zlib
 import numpy as np
 
 STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
-           "sensitivity", "readout", "next_shot", "replicate", "waves")
+           "sensitivity", "readout", "next_shot", "replicate", "waves", "check_posterior")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

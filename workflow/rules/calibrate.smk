@@ -35,7 +35,10 @@ rule calibrate:
 
 CHECK = config["calibration"]["check"]
 CHECK_BATCHES = list(range(chunk_count(CHECK["trials"], CHECK["trials_per_job"])))
-CHECK_TRUTHS = ["emulator", "hydrocode"]
+CHECK_TRUTHS = ["emulator", "hydrocode", "posterior"]
+# the hydrocode runs each truth reads: hydrocode truth a Latin hypercube over the box, posterior truth draws from the
+# joint posterior (docs/calibration.md, "Posterior truth")
+TRUTH_RUN_SETS = {"hydrocode": "check", "posterior": "check_posterior"}
 
 
 rule check_design:
@@ -54,18 +57,39 @@ rule check_design:
         "shockcal design --stream check_design --out {output} > {log} 2>&1"
 
 
+rule check_posterior_design:
+    """The posterior-truth check's truths: calibration.check.trials joint-posterior draws, each with its
+    lambda_y (run set "check_posterior"; seed stream check_posterior, apart from the predictive runs')."""
+    input:
+        posterior=expand(rules.calibrate.output.samples, name="joint"),
+    output:
+        run_set_path("check_posterior", "design.parquet"),
+    log:
+        f"{LOGS}/check/posterior_design.log",
+    benchmark:
+        f"{BENCHMARKS}/check/posterior_design.tsv"
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(config, "predict"),
+        runs=CHECK["trials"],
+    shell:
+        "shockcal predict --posterior {input.posterior} --n-runs {params.runs} --stream check_posterior"
+        " --out {output} > {log} 2>&1"
+
+
 rule calibration_check_batch:
     """One batch of synthetic-truth trials (each trial has its own random stream, so batches are
     independent jobs and together give what one run of every trial gives)."""
     input:
-        # hydrocode truth also reads the check design and its runs' features (the run set "check")
+        # hydrocode and posterior truth also read their truths' design and features (TRUTH_RUN_SETS)
         unpack(
             lambda w: (
                 {}
                 if w.truth == "emulator"
                 else {
-                    "design": rules.check_design.output[0],
-                    "features": expand(rules.features.output[0], run_set="check", shot=SHOTS),
+                    "design": run_set_path(TRUTH_RUN_SETS[w.truth], "design.parquet"),
+                    "features": expand(rules.features.output[0], run_set=TRUTH_RUN_SETS[w.truth], shot=SHOTS),
                 }
             )
         ),
@@ -121,7 +145,7 @@ CHECK_TARGETS = expand(rules.coverage.output[0], truth=CHECK_TRUTHS)
 
 
 rule check:
-    """The synthetic-truth coverage checks (calibration.check.trials each, emulator and hydrocode
-    truth): `make check`, outside the default study because of their cost (README)."""
+    """The synthetic-truth coverage checks (calibration.check.trials each; emulator, hydrocode and
+    posterior truth): `make check`, outside the default study because of their cost (README)."""
     input:
         CHECK_TARGETS,

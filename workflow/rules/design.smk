@@ -32,6 +32,7 @@ RUN_SET_SIZES = {
     "training": len(_PLANNED_DESIGN),
     "predict": config["predict"]["n_posterior_runs"],
     "check": config["calibration"]["check"]["trials"],
+    "check_posterior": config["calibration"]["check"]["trials"],
     "next_shot": config["next_shot"]["n_draws"],
 }
 WAVES = [f"wave{k}" for k in range(1, len(wave_sizes(config)))]  # none with design.strategy: lhs

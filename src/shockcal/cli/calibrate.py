@@ -45,7 +45,8 @@ def register(subparsers) -> None:
     trials.add_argument("--trials", type=int, help="override calibration.check.trials")
     trials.add_argument("--trial-range", metavar="START:STOP",
                         help="run trials START..STOP-1 only (a batch of the check; `shockcal coverage` merges them)")
-    c.add_argument("--truth-design", help="hydrocode truth: design table of the truth runs (CSV or Parquet)")
+    c.add_argument("--truth-design", help="hydrocode truth: design table of the truth runs (CSV or Parquet); alone, "
+                                          "the truths are its inputs and the emulator draws their features")
     c.add_argument("--truth-features", nargs="+", metavar="SHOT=TABLE",
                    help="hydrocode truth: the features of the truth runs per shot (with --truth-design)")
     c.add_argument("--seed-stream", nargs="+", metavar="KEY",
@@ -132,7 +133,7 @@ def run_check(args) -> int:
         logging.getLogger("shockcal.inference.sampler").setLevel(logging.WARNING)
     truths = hydro_truths(args)
     emulator = study_emulator(args.emulator, config)
-    truth = "emulator" if truths is None else "hydrocode"
+    truth = "emulator" if truths is None else "hydrocode" if truths.features is not None else "design-emulator"
     trials = trial_range(args.trial_range) or args.trials or config["calibration"]["check"]["trials"]
     stream = args.seed_stream or ["check", truth, *args.shots]
     try:
@@ -143,7 +144,8 @@ def run_check(args) -> int:
     settings = sampler_overrides(calibration_settings(config, args.shots, check=True), args.n_live, args.n_eff,
                                  draws_follow_n_eff=True)
     table = synthetic_truth(emulator, args.shots, settings, trials, seed=seed, truths=truths, draws=draws)
-    source = "emulator" if truths is None else f"hydrocode runs of {args.truth_design}"
+    source = ("emulator" if truths is None else f"hydrocode runs of {args.truth_design}" if truths.features is not None
+              else f"the emulator at the inputs of {args.truth_design}")
     write_table(table, args.out, {"table": "synthetic-truth coverage", "shots": args.shots, "truth": source})
     if draws is not None:
         import pandas as pd
@@ -206,6 +208,7 @@ def hydro_truths(args):
 
     if not args.truth_design and not args.truth_features:
         return None
-    if not (args.truth_design and args.truth_features):
-        raise InputError("calibrate-check: --truth-design and --truth-features go together")
-    return HydroTruths.read(args.truth_design, parse_pairs(args.truth_features, "--truth-features"), args.shots)
+    if not args.truth_design:
+        raise InputError("calibrate-check: --truth-features needs --truth-design (the truth runs' inputs)")
+    features = None if not args.truth_features else parse_pairs(args.truth_features, "--truth-features")
+    return HydroTruths.read(args.truth_design, features, args.shots)

@@ -19,7 +19,10 @@ def register(subparsers) -> None:
     p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
     p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
     p.add_argument("--n-runs", type=int, default=None, help="override predict.n_posterior_runs")
-    p.add_argument("--seed", type=int, default=None, help="override the seed (default: the study's posterior_draws stream)")
+    p.add_argument("--seed", type=int, default=None, help="override the seed (default: the study's --stream)")
+    p.add_argument("--stream", default="posterior_draws",
+                   help="the study seed's stream the draw is seeded from (default posterior_draws; the posterior-truth "
+                        "check's truths: check_posterior)")
     p.set_defaults(func=run)
 
     e = add_command(subparsers, "predict-emulator", example=EXAMPLE_PREDICT_EMULATOR,
@@ -43,15 +46,18 @@ def run(args) -> int:
 
     config = load_stage_config(args.config, "predict")
     n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
-    seed = stream_seed(config["study"]["seed"], "posterior_draws") if args.seed is None else args.seed
+    try:
+        seed = stream_seed(config["study"]["seed"], args.stream) if args.seed is None else args.seed
+    except ValueError as exc:
+        raise InputError(f"--stream: {exc}") from None
     posterior = read_table(args.posterior)
     shots = read_table_metadata(args.posterior).get("shots") if args.posterior.endswith((".parquet", ".pq")) else None
     if shots is not None and sorted(shots) != sorted(config["shots"]):
         raise InputError(f"{args.posterior}: a posterior of shots {shots}; predict draws from the joint posterior of the "
                          f"config's shots {sorted(config['shots'])}")
     design = draw_posterior_design(posterior, input_names(config), n_runs, seed, source=args.posterior,
-                                   bounds=prior_bounds(config))
-    units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
+                                   bounds=prior_bounds(config), carried=("lambda_y",))
+    units = {name: config["inputs"].get(name, {"unit": "-"})["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})
     logging.getLogger("shockcal.inference.predict").info("wrote %d posterior draws (seed %d) to %s", len(design), seed, args.out)

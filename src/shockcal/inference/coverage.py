@@ -30,10 +30,13 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     noise-free features either from the emulator (theta uniform on the box, features from its
     predictive distribution at theta) or, when `truths` is given, from hydrocode run number `trial`
     among the usable ones (`HydroTruths`; its design's `lambda_y` when the design has one, e.g. truths
-    drawn from a posterior). Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is
-    added and the features are calibrated with `settings` (the sampler reseeded from the trial's
-    stream). With `draws` (a list), each finished trial's equal-weight posterior draws are appended to
-    it as a table with `trial` and `run` columns. Columns:
+    drawn from a posterior). `truths` without features take theta from their design and the features
+    from the emulator's predictive distribution there: the same truths as their hydrocode runs with a
+    likelihood that is right by construction, so the two checks' difference is the emulator's.
+    Observation noise of sd = sd_fraction / sqrt(lambda_y) of each feature is added and the features
+    are calibrated with `settings` (the sampler reseeded from the trial's stream). With `draws` (a
+    list), each finished trial's equal-weight posterior draws are appended to it as a table with
+    `trial` and `run` columns. Columns:
     trial, run (the truth's hydrocode run; empty for emulator truth), parameter, truth, q05, q95, sd
     (posterior sd), inside (the 90% interval holds the truth), ess (Kish ESS),
     truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows), status ("ok" or
@@ -78,6 +81,8 @@ def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rn
         run, lam = None, None
     else:
         theta, eta, run, lam = hydro_draws[trial]
+        if eta is None:
+            eta = _emulator_features(emulator, shots, names, theta, rng)
     lam, y = _noisy_features(eta, settings.sd_fraction, rng, trial, lam)
     observed = pd.DataFrame(y.reshape(len(shots), -1), columns=emulator.feature_names).assign(shot=list(shots))
     trial_settings = settings.with_sampler(seed=int(rng.integers(2**31)))
@@ -120,38 +125,50 @@ def _noisy_features(eta, sd_fraction, rng, trial, lam=None, attempts: int = 100)
 
 def _emulator_truth(emulator, shots, names, rng, box):
     """(theta, features): theta uniform on the prior box (lower, upper), features from the emulator's
-    predictive distribution at theta (its error model's, block by block)."""
+    predictive distribution at theta (`_emulator_features`)."""
     lower, upper = box
     theta = rng.uniform(lower, upper)
+    return theta, _emulator_features(emulator, shots, names, theta, rng)
+
+
+def _emulator_features(emulator, shots, names, theta, rng) -> np.ndarray:
+    """One draw of the features (F,) from the emulator's predictive distribution at theta (its error
+    model's, block by block)."""
     mean, cov = emulator.predict({k: np.array([v]) for k, v in zip(names, theta)}, shots)
     features = np.empty(mean.shape[1])
     for cols, error in emulator.error_groups(shots):
         features[cols] = error.sample(mean[0, cols], cov[0, cols[:, None], cols[None, :]], rng)
-    return theta, features
+    return features
 
 
 class Truth(NamedTuple):
-    """One hydrocode truth: its inputs, its runs' features (every shot's, m/s), its run id, its lambda_y or None."""
+    """One hydrocode truth: its inputs, its runs' features (every shot's, m/s; None: the emulator's), its run
+    id, its lambda_y or None."""
 
     theta: np.ndarray
-    features: np.ndarray
+    features: np.ndarray | None
     run: int
     lambda_y: float | None
 
 
 @dataclass
 class HydroTruths:
-    """Hydrocode runs as synthetic truth: their design (theta per run) and, per shot, their features."""
+    """Hydrocode runs as synthetic truth: their design (theta per run) and, per shot, their features; without
+    features (None), the design's inputs alone, the features drawn from the emulator (`synthetic_truth`)."""
 
     design: pd.DataFrame
-    features: dict            # shot -> features table (run, status, feature columns)
+    features: dict | None     # shot -> features table (run, status, feature columns)
 
     @classmethod
-    def read(cls, design_path, feature_paths: dict, shots) -> HydroTruths:
+    def read(cls, design_path, feature_paths: dict | None, shots) -> HydroTruths:
         """From a design table and each shot's features table (CSV or Parquet); every shot calibrated
-        needs its features."""
+        needs its features. `feature_paths` None: the design alone."""
         from shockcal.io import check_unique, integer_ids, read_table, require_columns
 
+        if feature_paths is None:
+            design = integer_ids(read_table(design_path), "run", design_path)
+            check_unique(design, "run", design_path, "run")
+            return cls(design, None)
         missing = sorted(set(shots) - set(feature_paths))
         if missing:
             raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
@@ -165,8 +182,17 @@ class HydroTruths:
 
     def table(self, names, shots) -> list[Truth]:
         """A `Truth` per usable run (every shot's features ok and positive), in run order; its lambda_y is
-        the design's `lambda_y` when it has one, else None (drawn from the prior)."""
+        the design's `lambda_y` when it has one, else None (drawn from the prior). Without features, every
+        design row is a truth, its features None."""
+        from shockcal.io import require_columns
+
         table = self.design.set_index("run")
+        if self.features is None:
+            require_columns(self.design, names, "truth design")
+            table = table.sort_index()
+            lam = table["lambda_y"].to_numpy(float) if "lambda_y" in table else [None] * len(table)
+            return [Truth(theta, None, run, value) for theta, run, value in
+                    zip(table[names].to_numpy(float), table.index.to_numpy(int).tolist(), lam)]
         for shot in shots:
             ok = self.features[shot].query("status == 'ok'").set_index("run")
             table = table.join(ok[CALIBRATION_FEATURES].add_prefix(f"{shot}:"), how="inner")

@@ -21,8 +21,8 @@ log = logging.getLogger(__name__)
 
 
 def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, seed: int,
-                          source: str = "posterior", bounds: Mapping[str, tuple[float, float]] | None = None
-                          ) -> pd.DataFrame:
+                          source: str = "posterior", bounds: Mapping[str, tuple[float, float]] | None = None,
+                          carried: tuple[str, ...] = ()) -> pd.DataFrame:
     """`n` rows drawn (seeded, without replacement when possible) from the posterior samples.
 
     Args:
@@ -32,8 +32,11 @@ def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, see
         seed: the draw's seed.
         source: names `posterior` in errors.
         bounds: the study's prior box by input (native units): every sample must lie in it.
+        carried: posterior columns that are not inputs, kept after them when the posterior has them
+            (`lambda_y`: a check that takes the draws as truths needs each one's observation precision;
+            the hydrocode reads only the inputs).
 
-    Returns a design table: `run` 0..n-1 and the inputs `names`. An empty table, a missing input, a
+    Returns a design table: `run` 0..n-1, the inputs `names` and the `carried` columns present. An empty table, a missing input, a
     value that is not a finite number, or a sample outside `bounds` (a posterior of another study or
     box) is an InputError naming `source`, the row and the input.
     """
@@ -58,7 +61,8 @@ def draw_posterior_design(posterior: pd.DataFrame, names: list[str], n: int, see
     if replace:
         log.warning("%s: only %d samples for %d posterior runs; drawing with replacement", source, len(posterior), n)
     rows = np.random.default_rng(seed).choice(len(posterior), size=n, replace=replace)
-    design = posterior.iloc[np.sort(rows)][names].reset_index(drop=True).astype(float)
+    columns = [*names, *(name for name in carried if name in posterior.columns)]
+    design = posterior.iloc[np.sort(rows)][columns].reset_index(drop=True).astype(float)
     design.insert(0, "run", np.arange(n, dtype=np.int64))
     return design
 
