@@ -20,6 +20,7 @@ from shockcal.inference.coverage import (
     coverage_table,
     hpd_mass,
     joint_coverage,
+    paired_coverage,
     synthetic_truth,
 )
 from shockcal.inference.problem import Problem, log_density
@@ -217,6 +218,37 @@ def test_joint_coverage_of_uniform_and_of_too_narrow_masses():
     assert bad["coverage90"] < bad["band_low"] and bad["uniform_ks_p"] < 1e-6
 
 
+def _check_rows(inside_a, inside_n, masses, runs):
+    """A per-trial table of two parameters (A, n) with the given inside flags, truth masses and runs."""
+    rows = [{"trial": t, "run": run, "parameter": name, "truth": 0.5, "q05": 0.0, "q95": 1.0 if flag else 0.1,
+             "inside": flag, "ess": 900.0, "truth_hpd_mass": mass, "status": "ok", "reason": ""}
+            for t, (a, n, mass, run) in enumerate(zip(inside_a, inside_n, masses, runs))
+            for name, flag in (("A", a), ("n", n))]
+    return pd.DataFrame(rows)
+
+
+def test_paired_coverage_counts_the_trials_one_check_alone_covers():
+    """Six trials covered by the hydrocode check alone and none by the reference alone give McNemar's
+    exact p = 2 / 2^6; identical checks give 1; the joint row reads the truth masses; checks on other
+    truths, or with no trial in common, are refused."""
+    n = 20
+    here = _check_rows([True] * n, [True] * 10 + [False] * 10, np.linspace(0.0, 0.95, n), range(n))
+    there = _check_rows([True] * 14 + [False] * 6, [True] * 10 + [False] * 10, np.linspace(0.0, 0.95, n)[::-1],
+                        range(n))
+    table = paired_coverage(here, there).set_index("parameter")
+    assert table.loc["A", ["only_here", "only_reference"]].tolist() == [6, 0]
+    assert table.loc["A", "mcnemar_p"] == pytest.approx(2 / 2**6)
+    assert table.loc["A", "coverage90"] == 1.0 and table.loc["A", "reference_coverage90"] == pytest.approx(0.7)
+    assert table.loc["n", "mcnemar_p"] == 1.0 and table.loc["n", "only_here"] == 0
+    masses = np.linspace(0.0, 0.95, n)
+    assert table.loc["joint", "coverage90"] == np.mean(masses <= 0.9)
+    assert table.loc["joint", "only_here"] == np.sum((masses <= 0.9) & (masses[::-1] > 0.9))
+    with pytest.raises(InputError, match="trial 0 has truth run 0 in one check and 5"):
+        paired_coverage(here, there.assign(run=there["run"] + 5))
+    with pytest.raises(InputError, match="share no finished trial"):
+        paired_coverage(here, there.assign(status="failed"))
+
+
 def test_synthetic_truth_in_batches_equals_one_run(three_toy_trials):
     # each trial has its own random stream: the workflow's batches of trials are independent jobs
     emu, config, whole = three_toy_trials
@@ -257,6 +289,21 @@ def test_coverage_command_merges_batches_and_rejects_a_repeated_trial(tmp_path, 
     assert main(["coverage", "--trials", second, again, "--out", str(tmp_path / "bad.parquet")]) == 2
     assert "trial 5 is in more than one" in capsys.readouterr().err
     assert not (tmp_path / "bad.parquet").exists()
+    assert main(["coverage", "--trials", first, "--out", str(tmp_path / "one.parquet"), "--against", second]) == 2
+    assert "the check has no truth runs" in capsys.readouterr().err
+
+
+def test_coverage_command_compares_two_checks_on_the_same_truths(tmp_path, caplog):
+    from shockcal.cli import main
+
+    paths = []
+    for name, flags in (("here", [True] * 8 + [False] * 2), ("there", [True] * 4 + [False] * 6)):
+        paths.append(str(tmp_path / f"{name}.parquet"))
+        _check_rows(flags, flags, np.linspace(0.0, 0.95, 10), range(10)).to_parquet(paths[-1])
+    with caplog.at_level("INFO", logger="shockcal.calibrate"):
+        assert main(["coverage", "--trials", paths[0], "--out", str(tmp_path / "all.parquet"), "--against",
+                     paths[1]]) == 0
+    assert re.search(r"\n\s+A\s+10\s+0\.800\s+0\.400\s+4\s+0\s+0\.125", caplog.text), caplog.text
 
 
 @pytest.mark.slow

@@ -61,6 +61,9 @@ def register(subparsers) -> None:
                     help="merge per-trial tables of calibrate-check batches; print the coverage")
     m.add_argument("--trials", required=True, nargs="+", help="per-trial tables (calibrate-check --out)")
     m.add_argument("--out", required=True, help="merged per-trial table (Parquet)")
+    m.add_argument("--against", nargs="+", metavar="TABLE",
+                   help="another check's per-trial tables on the same truths (e.g. `calibrate-check --truth-design` "
+                        "alone: the emulator's features there); the log adds the trial-by-trial comparison")
     m.set_defaults(func=run_coverage)
 
 
@@ -159,12 +162,21 @@ def run_check(args) -> int:
 
 
 def run_coverage(args) -> int:
-    from shockcal.inference.coverage import coverage_table
+    import logging
+
+    from shockcal.inference.coverage import coverage_table, paired_coverage
     from shockcal.io import read_tables, write_table
 
     table = read_tables(args.trials, ["trial", "parameter"], "per-trial")
+    reference = None if not args.against else read_tables(args.against, ["trial", "parameter"], "per-trial")
+    paired = None if reference is None else paired_coverage(table, reference)
     write_table(table, args.out, {"table": "synthetic-truth coverage", "batches": args.trials})
     log_coverage(coverage_table(table), table)
+    if paired is not None:
+        logging.getLogger("shockcal.calibrate").info(
+            "trial by trial against %s (only_here / only_reference: trials one check alone covers; mcnemar_p: "
+            "exact two-sided, small where the checks differ):\n%s", " ".join(args.against),
+            paired.to_string(index=False, float_format="%.3f"))
     return 0
 
 

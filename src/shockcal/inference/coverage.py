@@ -259,6 +259,48 @@ def joint_coverage(trials: pd.DataFrame) -> dict:
             "band_high": band_high, "uniform_ks_p": float(stats.kstest(mass, "uniform").pvalue)}
 
 
+def paired_coverage(trials: pd.DataFrame, reference: pd.DataFrame) -> pd.DataFrame:
+    """Two checks on the same truths compared trial by trial: `trials` (e.g. hydrocode features at
+    posterior draws) against `reference` (the same draws' inputs with the emulator's features, a
+    likelihood right by construction). Where the reference misses too, a miss is not the emulator's;
+    the trials that differ tell the two apart.
+
+    Per parameter, then `joint` (the truth in the 90% highest-density region; when both checks have
+    `truth_hpd_mass`), over the trials both
+    finished with the same run as truth: `trials`, `coverage90`, `reference_coverage90`, `only_here`
+    and `only_reference` (trials covered by one check alone) and `mcnemar_p`, the exact two-sided
+    McNemar p-value (binomial test of the discordant trials against 1/2; 1 with none). A run id that
+    differs between the checks at a trial is an InputError: they are not on the same truths."""
+    for table, which in ((trials, "the check"), (reference, "the reference")):
+        if "run" not in table or table["run"].isna().all():
+            raise InputError(f"paired coverage: {which} has no truth runs (emulator truth over the box); only checks "
+                             "on the same truth runs pair up")
+    keys = ["trial", "parameter"]
+    both = usable_trials(trials).merge(usable_trials(reference), on=keys, suffixes=("", "_reference"))
+    if both.empty:
+        raise InputError("paired coverage: the two checks share no finished trial")
+    other = both["run"].ne(both["run_reference"]) & both["run"].notna()
+    if other.any():
+        row = both[other].iloc[0]
+        raise InputError(f"paired coverage: trial {row['trial']} has truth run {row['run']} in one check and "
+                         f"{row['run_reference']} in the other; compare checks on the same truths")
+    both = both.astype({"inside": bool, "inside_reference": bool})
+    if {"truth_hpd_mass", "truth_hpd_mass_reference"} <= set(both) and both["truth_hpd_mass"].notna().all():
+        joint = both.groupby("trial").first().reset_index().assign(
+            parameter="joint", inside=lambda t: t["truth_hpd_mass"] <= 0.9,
+            inside_reference=lambda t: t["truth_hpd_mass_reference"] <= 0.9)
+        both = pd.concat([both, joint], ignore_index=True)
+    rows = []
+    for name, group in both.groupby("parameter", sort=False):
+        here, there = group["inside"].to_numpy(bool), group["inside_reference"].to_numpy(bool)
+        only_here, only_there = int(np.sum(here & ~there)), int(np.sum(there & ~here))
+        discordant = only_here + only_there
+        rows.append({"parameter": name, "trials": len(group), "coverage90": here.mean(),
+                     "reference_coverage90": there.mean(), "only_here": only_here, "only_reference": only_there,
+                     "mcnemar_p": stats.binomtest(only_here, discordant, 0.5).pvalue if discordant else 1.0})
+    return pd.DataFrame(rows)
+
+
 def binomial_band(trials):
     """The central 95% band of the share of `trials` (a count or an array of counts) that a
     calibrated 90% interval covers."""
