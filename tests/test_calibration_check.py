@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import json
 import re
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -190,6 +191,10 @@ def test_coverage_by_fifth_finds_the_misses_at_low_truths():
     fifth_of_a = (pd.Series(a_truth).rank(method="first").to_numpy() - 1) * 5 // 100
     misses = np.bincount(fifth_of_a[:10].astype(int), minlength=5)
     np.testing.assert_allclose(table.loc["A"], 1.0 - misses / 20)
+    with warnings.catch_warnings():                  # four trials: the fifth fifth is empty, NaN and no warning
+        warnings.simplefilter("error")
+        few = coverage_by_fifth(rows[rows["trial"] < 4])
+    assert few.loc["n"].isna().tolist() == [False] * 4 + [True]
 
 
 def test_hpd_mass_of_a_known_gaussian():

@@ -237,14 +237,16 @@ def coverage_by_fifth(trials: pd.DataFrame, fifths: int = 5) -> pd.DataFrame:
     lowest fifth of the truths first), the share of 90% intervals holding the truth, over the trials
     that finished. Truths drawn evenly over the box (a Latin hypercube, uniform draws) put each fifth
     of the truths in a fifth of the box; a method that is right everywhere gives about 0.90 in every
-    cell, with a binomial sd of sqrt(0.09 / (trials / fifths)) (0.067 for 20 trials a cell)."""
+    cell, with a binomial sd of sqrt(0.09 / (trials / fifths)) (0.067 for 20 trials a cell). A fifth
+    without a trial (fewer trials than fifths) is NaN."""
     usable = usable_trials(trials).astype({"inside": bool})
     columns = [f"{k}/{fifths}" for k in range(1, fifths + 1)]
 
     def by_rank(group: pd.DataFrame) -> pd.Series:
         rank = group["truth"].rank(method="first").to_numpy() - 1
         fifth = (rank * fifths // len(group)).astype(int)
-        return pd.Series([group["inside"].to_numpy()[fifth == k].mean() for k in range(fifths)], columns)
+        inside = group["inside"].to_numpy()
+        return pd.Series([inside[fifth == k].mean() if np.any(fifth == k) else np.nan for k in range(fifths)], columns)
 
     return usable.groupby("parameter", sort=False)[["truth", "inside"]].apply(by_rank)
 
