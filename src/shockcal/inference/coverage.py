@@ -165,20 +165,17 @@ class HydroTruths:
         needs its features. `feature_paths` None: the design alone."""
         from shockcal.io import check_unique, integer_ids, read_table, require_columns
 
-        if feature_paths is None:
-            design = integer_ids(read_table(design_path), "run", design_path)
-            check_unique(design, "run", design_path, "run")
-            return cls(design, None)
-        missing = sorted(set(shots) - set(feature_paths))
+        missing = [] if feature_paths is None else sorted(set(shots) - set(feature_paths))
         if missing:
             raise InputError(f"calibrate-check: no --truth-features for shot(s) {missing}")
         tables = {}
-        for path in [design_path, *feature_paths.values()]:
+        for path in [design_path, *(feature_paths or {}).values()]:
             table = read_table(path)
             require_columns(table, ["run"] if path == design_path else ["run", "status", *CALIBRATION_FEATURES], path)
             tables[path] = integer_ids(table, "run", path)
             check_unique(tables[path], "run", path, "run")
-        return cls(tables[design_path], {shot: tables[path] for shot, path in feature_paths.items()})
+        features = None if feature_paths is None else {shot: tables[path] for shot, path in feature_paths.items()}
+        return cls(tables[design_path], features)
 
     def table(self, names, shots) -> list[Truth]:
         """A `Truth` per usable run (every shot's features ok and positive), in run order; its lambda_y is
@@ -186,22 +183,20 @@ class HydroTruths:
         design row is a truth, its features None."""
         from shockcal.io import require_columns
 
+        require_columns(self.design, names, "truth design")
         table = self.design.set_index("run")
-        if self.features is None:
-            require_columns(self.design, names, "truth design")
-            table = table.sort_index()
-            lam = table["lambda_y"].to_numpy(float) if "lambda_y" in table else [None] * len(table)
-            return [Truth(theta, None, run, value) for theta, run, value in
-                    zip(table[names].to_numpy(float), table.index.to_numpy(int).tolist(), lam)]
-        for shot in shots:
+        for shot in shots if self.features is not None else []:
             ok = self.features[shot].query("status == 'ok'").set_index("run")
             table = table.join(ok[CALIBRATION_FEATURES].add_prefix(f"{shot}:"), how="inner")
-        columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES]
+        columns = [f"{shot}:{f}" for shot in shots for f in CALIBRATION_FEATURES] if self.features is not None else []
         usable = table[(table[columns] > 0).all(axis=1)].sort_index()
-        log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable), len(self.design))
+        if self.features is not None:
+            log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable),
+                     len(self.design))
         lam = usable["lambda_y"].to_numpy(float) if "lambda_y" in usable else [None] * len(usable)
-        return [Truth(*row) for row in zip(usable[names].to_numpy(float), usable[columns].to_numpy(float),
-                                           usable.index.to_numpy(int).tolist(), lam)]
+        features = usable[columns].to_numpy(float) if columns else [None] * len(usable)
+        return [Truth(*row) for row in zip(usable[names].to_numpy(float), features, usable.index.to_numpy(int).tolist(),
+                                           lam)]
 
 
 def usable_trials(trials: pd.DataFrame) -> pd.DataFrame:
