@@ -27,7 +27,7 @@ define study
 endef
 
 .DEFAULT_GOAL := help
-.PHONY: help env study sequential quick flag-archive models models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: help env study sequential quick flag-archive models models-reduced models-sequential models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 help:  ## these targets, one line each
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
@@ -73,6 +73,9 @@ models: $(INSTALLED)  ## every law's study (strength.model) into results/models/
 
 models-reduced: $(INSTALLED)  ## the same at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
+
+models-sequential: $(INSTALLED)  ## the same with every law's runs in waves (config/sequential.yaml: 300 training and 33 predictive runs per shot) into results/models-sequential
+	$(MAKE) models MODELS_CONFIG="config/config.yaml config/sequential.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-sequential)
 
 models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into results/models-quick
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/quick.yaml" MODELS_DIR=results/models-quick
