@@ -62,7 +62,8 @@ MODELS_DIR ?= results/models
 models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
 	for model in $(MODELS); do \
 	  $(call snakemake,$(MODELS_DIR)/$$model) --cores $(CORES) --configfile $(MODELS_CONFIG) --config "strength={model: $$model}" \
-	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.nc || exit 1; \
+	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.nc \
+	    $(MODELS_DIR)/$$model/report/emulator_heldout.csv || exit 1; \
 	done
 	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
 	  --figures-dir $(MODELS_DIR)/figures

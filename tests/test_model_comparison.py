@@ -84,6 +84,7 @@ def test_command_reads_each_study(tmp_path):
     assert table.loc["zerilli-armstrong", "kfold_rmse_m_s"] == 11.0
     assert table.loc["zerilli-armstrong", "log_bf_sd"] == pytest.approx(math.hypot(0.03, 0.04))
     assert math.isnan(table.loc["ptw", "outer_rmse_m_s"]) and "ptw" in done.stderr and "no outer check" in done.stderr
+    assert table["heldout_rmse_m_s"].isna().all() and table["heldout_coverage"].isna().all()   # no predictive runs
     missing = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
                               "--model", f"ptw={tmp_path / 'nowhere'}", "--out", str(out)], capture_output=True, text=True)
     assert missing.returncode != 0
@@ -99,3 +100,25 @@ def test_command_reads_each_study(tmp_path):
                               "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
     assert damaged.returncode != 0 and "Traceback" not in damaged.stderr
     assert "emulator.json: not an emulator's JSON description" in damaged.stderr
+
+
+def test_the_emulator_on_each_laws_predictive_runs_joins_its_row(tmp_path):
+    """A study with report/emulator_heldout.csv (the emulator on its posterior's predictive runs): its overall row's
+    RMSE and band coverage; a table without that row is one line naming the file."""
+    jc = _study(tmp_path, "jc", -45.0, 0.03, 12.4, 21.0)
+    (jc / "report").mkdir()
+    (jc / "report" / "emulator_heldout.csv").write_text(
+        "feature,rmse_m_s,coverage,mean_z2,n_values,block,n_features,n_runs\n"
+        "104S:v_elastic,1.5,0.95,0.8,99,,,\nall (99 runs),2.79,0.928,0.9,1188,,,\n"
+        ",,0.9,,,104S+105S+106S,12,99\n")
+    out = tmp_path / "evidence.csv"
+    done = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"johnson-cook={jc}",
+                           "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    row = pd.read_csv(out).iloc[0]
+    assert row["heldout_rmse_m_s"] == 2.79 and row["heldout_coverage"] == 0.928
+    (jc / "report" / "emulator_heldout.csv").write_text("feature,rmse_m_s,coverage\n104S:v_elastic,1.5,0.95\n")
+    bad = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"johnson-cook={jc}",
+                          "--out", str(out)], capture_output=True, text=True)
+    assert bad.returncode != 0 and len(bad.stderr.strip().splitlines()) == 1
+    assert "emulator_heldout.csv: no 'all (N runs)' row" in bad.stderr

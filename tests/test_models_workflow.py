@@ -38,14 +38,28 @@ def test_models_reduced_runs_each_law_to_its_predictive_runs(tmp_path):
     printed = make_dry_run("models-reduced", MODELS="johnson-cook ptw", MODELS_DIR=tmp_path)
     command = law_command(printed, "ptw")
     assert command[command.index("--configfile") + 1:][:2] == ["config/config.yaml", "config/models-reduced.yaml"]
-    assert command[-2:] == ["--", f"{tmp_path}/ptw/posterior/joint.nc"]
+    assert command[-3:] == ["--", f"{tmp_path}/ptw/posterior/joint.nc", f"{tmp_path}/ptw/report/emulator_heldout.csv"]
     assert f"--config config/config.yaml --model johnson-cook={tmp_path}/johnson-cook --model ptw={tmp_path}/ptw" in printed
     assert f"--out {tmp_path}/release.csv" in printed and f"--out {tmp_path}/evidence.csv" in printed
     dry = subprocess.run([SNAKEMAKE, "--dry-run", *command[1:]], cwd=REPO, capture_output=True, text=True)
     assert dry.returncode == 0, dry.stdout[-2000:] + dry.stderr[-2000:]
     predict_chunks = re.findall(r"^rule simulate:\n(?:\s+.*\n)*?\s+wildcards: run_set=predict", dry.stdout, flags=re.M)
     assert len(predict_chunks) == 3 * 2                             # 3 shots x ceil(30 / 25) chunks
-    assert "rule posterior_netcdf:" in dry.stdout
+    assert "rule posterior_netcdf:" in dry.stdout and "rule report_heldout:" in dry.stdout
+
+
+def test_models_sequential_runs_each_law_in_waves(tmp_path):
+    """`make models-sequential`: config/sequential.yaml over the paper's config, each law's runs in waves (its
+    steps' emulators and posteriors), to its joint posterior and its emulator scored on the predictive runs."""
+    printed = make_dry_run("models-sequential", MODELS="johnson-cook ptw", MODELS_DIR=tmp_path)
+    command = law_command(printed, "ptw")
+    assert command[command.index("--configfile") + 1:][:2] == ["config/config.yaml", "config/sequential.yaml"]
+    dry = subprocess.run([SNAKEMAKE, "--dry-run", *command[1:]], cwd=REPO, capture_output=True, text=True)
+    assert dry.returncode == 0, dry.stdout[-2000:] + dry.stderr[-2000:]
+    for rule in ("wave_design", "wave_calibrate", "report_heldout"):
+        assert f"rule {rule}:" in dry.stdout, rule
+    waves = re.findall(r"wildcards: run_set=wave(\d), shot=", dry.stdout)
+    assert sorted(set(waves)) == ["1", "2"]
 
 
 def test_models_quick_is_the_paper_config_with_the_quick_overlay(tmp_path):

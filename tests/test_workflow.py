@@ -278,7 +278,7 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
     grown = tmp_path / "design.parquet"
     design.to_parquet(grown)
     shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4")
-    more = overlay(tmp_path / "shot.yaml", design={"file": str(grown)}, inputs={"V4": box},
+    more = overlay(tmp_path / "shot.yaml", design={"file": str(grown), "new_shots": {"runs_from": "training"}}, inputs={"V4": box},
                    shots={"107S": shot}, observed={"records": {"107S": _own_record(quick, tmp_path)}})
     jobs = pending_jobs(config, more)
     assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
@@ -286,12 +286,14 @@ def test_added_shot_with_its_own_velocity_runs_only_its_simulations(study, tmp_p
 
 def test_a_shot_added_by_config_alone_runs_only_its_simulations(study, tmp_path):
     """Adding a shot is a config edit: its own impact velocity and modulus increment under `inputs`,
-    the shot and its record. The design grows by itself (`design.base_shots`): only its chunks run."""
+    the shot and its record. With `design.new_shots.runs_from: training` the design grows by itself
+    (`design.base_shots`): only its training chunks run (the default, its own runs: tests/test_new_shots.py)."""
     results, config = study
     quick = load_config(REPO / "config" / "config.yaml")
     shot = dict(quick["shots"]["106S"], target_mm=4.0, velocity_input="V4", shear_modulus_inputs=["G1", "Delta4"])
     more = overlay(tmp_path / "shot.yaml", inputs={"V4": quick["inputs"]["V3"], "Delta4": quick["inputs"]["Delta3"]},
-                   shots={"107S": shot}, observed={"records": {"107S": _own_record(quick, tmp_path)}})
+                   shots={"107S": shot}, observed={"records": {"107S": _own_record(quick, tmp_path)}},
+                   design={"new_shots": {"runs_from": "training"}})
     jobs = pending_jobs(config, more)
     assert jobs["simulate"] == jobs["features_chunk"] == 4 and jobs["features"] == 1, jobs   # 107S's 4 chunks
 

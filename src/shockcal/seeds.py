@@ -22,6 +22,7 @@ keyed further (an emulator block index, a calibration's shots).
 | replicate | a calibration's runs after its first (`calibration.replicates`), keyed by run, rooted at the calibration's seed |
 | waves | a sequential study's later waves: the posterior pool of wave k ("pool", k) |
 | check_posterior | the joint-posterior draws the posterior-truth check takes as truths (`shockcal predict --stream`) |
+| new_shot | a new shot's runs (`design.new_shots`): the posterior pool, keyed by shot; its own inputs, by shot and input |
 """
 from __future__ import annotations
 
@@ -30,7 +31,8 @@ import zlib
 import numpy as np
 
 STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
-           "sensitivity", "readout", "next_shot", "replicate", "waves", "check_posterior")
+           "sensitivity", "readout", "next_shot", "replicate", "waves", "check_posterior",
+           "new_shot")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

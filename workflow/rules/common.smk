@@ -7,7 +7,14 @@ import yaml
 
 from shockcal.design.tables import chunk_fingerprints, write_design
 from shockcal.errors import ShockcalError
-from shockcal.study.adapters import input_box, shot_mapping, study_design
+from shockcal.study.adapters import (
+    base_study_config,
+    input_box,
+    new_posterior_shots,
+    new_shot_config,
+    shot_mapping,
+    study_design,
+)
 from shockcal.study.next_shot_check import plan_check
 from shockcal.study.config import run_cost_mm_us, wave_sizes
 from shockcal.study.simulator import simulator_kind
@@ -39,6 +46,27 @@ onstart:
 
 
 CHUNK_SIZE = config["simulate"]["chunk_size"]
+
+# New shots (design.new_shots.runs_from: posterior; docs/workflow.md, "Adding a shot"): each runs design.new_shots.n_runs
+# rows of its own (the run set new_shot), placed by the base shots' emulator and joint posterior (waves.smk's last
+# step). The base jobs' params are the study without the new shots (BASE_STUDY), and their commands read only the
+# base shots, so adding a shot reruns none of them and no base shot's runs; the base observed features are made
+# under that study's config (BASE_CONFIG_OPTION).
+NEW_SHOTS = new_posterior_shots(config)
+BASE_SHOTS = [shot for shot in SHOTS if shot not in NEW_SHOTS]
+BASE_STUDY = base_study_config(config) if NEW_SHOTS else config
+if NEW_SHOTS:
+    _BASE_TEXT = yaml.safe_dump(BASE_STUDY, sort_keys=True)
+    _BASE_CONFIG = f"{RESULTS}/config/base-{hashlib.sha256(_BASE_TEXT.encode()).hexdigest()[:12]}.yaml"
+    write_if_changed(_BASE_CONFIG, _BASE_TEXT)
+BASE_CONFIG_OPTION = f"--config {_BASE_CONFIG}" if NEW_SHOTS else ""
+
+
+def training_run_set(shot):
+    """The run set a shot's emulator is fitted on: its own (new_shot) for a new shot, else the training runs."""
+    return "new_shot" if shot in NEW_SHOTS else "training"
+
+
 # an archive study (simulator.kind archive, docs/simulators.md) has its training runs and no code to run
 # others: the posterior's predictive runs (the run set predict) and what reads them are left out of `all`
 ARCHIVE_STUDY = simulator_kind(config) == "archive"
@@ -59,8 +87,8 @@ def run_set_design(wildcards):
     (its derived study's training design, planned at parse time; its truths, next_shot_check.smk)."""
     if wildcards.run_set == "training":
         return ancient(DESIGN)
-    if wildcards.run_set == "next_shot":
-        return run_set_path("next_shot", "designs", f"{wildcards.shot}.parquet")
+    if wildcards.run_set in ("next_shot", "new_shot"):
+        return run_set_path(wildcards.run_set, "designs", f"{wildcards.shot}.parquet")
     if wildcards.run_set == "next_shot_check":
         return ancient(CHECK_PLANS[wildcards.shot]["design"])
     if wildcards.run_set == "next_shot_truth" and wildcards.shot not in SHOTS:
@@ -140,11 +168,11 @@ def wave_design_path(wave):
 
 
 def step_features(step):
-    """The features of every shot of waves 0..`step`, wave after wave."""
+    """The features of every base shot of waves 0..`step`, wave after wave."""
     return [
         rules.features.output[0].format(run_set=run_set, shot=shot)
         for run_set in WAVE_RUN_SETS[: int(step) + 1]
-        for shot in SHOTS
+        for shot in BASE_SHOTS
     ]
 
 
@@ -165,8 +193,24 @@ def wave_design_inputs(wildcards):
         "previous": wave_design_path(k - 1),
         "runs": rules.merge_runs.output.design.format(step=k - 1),
         "emulator": rules.wave_emulator.output.emulator.format(step=k - 1),
-        "observed": rules.observed.output[0],
+        "observed": rules.observed_base.output[0],
     }
     if k >= 2:
         inputs["earlier"] = rules.wave_calibrate.output.summary.format(step=k - 2)
     return inputs
+
+
+def record_paths(study):
+    """The measured records a study's observed features read (none with published features)."""
+    records = study["observed"]["records"].values() if study["observed"]["source"] == "records" else []
+    return [spec["path"] for spec in records]
+
+
+def study_features(shot):
+    """The features a shot's part of the study's emulator is fitted on: the last step's (every wave's) or the
+    training runs' for a base shot, its own runs' for a new shot."""
+    if shot in NEW_SHOTS:
+        return rules.features.output[0].format(run_set="new_shot", shot=shot)
+    if WAVES:
+        return step_path(LAST_STEP, "features", f"{shot}.parquet")
+    return rules.features.output[0].format(run_set="training", shot=shot)

@@ -60,4 +60,7 @@ CHECK_DIGESTS = {
 #             their derived studies' designs; next_shot_truth: the check's truths at the shots and the candidates.
 RUN_SET_SIZES["next_shot_check"] = config["next_shot"]["check"]["n_training_runs"]
 RUN_SET_SIZES["next_shot_truth"] = config["next_shot"]["check"]["n_truths"]
+#   new_shot: design.new_shots.n_runs rows per new shot, from the base shots' joint posterior (waves.smk), each
+#             shot's own design ({RESULTS}/new_shot/designs/<shot>.parquet)
+RUN_SET_SIZES["new_shot"] = config["design"]["new_shots"]["n_runs"]
 RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SET_SIZES.items()}

@@ -7,6 +7,7 @@ rule emulator:
     input:
         design=STUDY_RUNS["design"],  # the training runs; a sequential study's every wave (waves.smk)
         features=STUDY_RUNS["features"],
+        shot_designs=STUDY_RUNS["shot_designs"],
     output:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",
@@ -22,7 +23,14 @@ rule emulator:
     threads: config["emulator"]["n_jobs"]
     params:
         settings=stage_config(config, "emulate"),
-        pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features)),
+        # the features' SHOT=FILE pairs, then each new shot's own design (--shot-design): one param, so the
+        # command of a study without new shots is the one it ran with (a changed command reruns the emulator)
+        pairs=lambda w, input: " ".join(
+            [
+                pairs(SHOTS, input.features),
+                *(["--shot-design", pairs(NEW_SHOTS, input.shot_designs)] if NEW_SHOTS else []),
+            ]
+        ),
         out=lambda w, output: os.path.dirname(output.emulator),
     shell:
         "shockcal emulate --design {input.design} --features {params.pairs}" " --out {params.out} > {log} 2>&1"

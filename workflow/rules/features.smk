@@ -48,9 +48,7 @@ rule features:
 
 rule observed:
     input:
-        [spec["path"] for spec in config["observed"]["records"].values()]
-        if config["observed"]["source"] == "records"
-        else [],
+        record_paths(config),
     output:
         f"{RESULTS}/features/observed.parquet",
     log:
@@ -65,5 +63,25 @@ rule observed:
         "shockcal observed --out {output} > {log} 2>&1"
 
 
-ALL_TARGETS += expand(rules.features.output[0], run_set="training", shot=SHOTS)
+rule observed_base:
+    """The base shots' observed features (the study without its new shots, common.smk), which a sequential
+    study's steps and the new shots' design read: a shot added later leaves this file alone."""
+    input:
+        record_paths(BASE_STUDY),
+    output:
+        f"{RESULTS}/features/observed_base.parquet",
+    log:
+        f"{LOGS}/observed_base.log",
+    benchmark:
+        f"{BENCHMARKS}/observed_base.tsv"
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=stage_config(BASE_STUDY, "observed"),
+        config=BASE_CONFIG_OPTION,
+    shell:
+        "shockcal observed {params.config} --out {output} > {log} 2>&1"
+
+
+ALL_TARGETS += [rules.features.output[0].format(run_set=training_run_set(shot), shot=shot) for shot in SHOTS]
 ALL_TARGETS += rules.observed.output

@@ -24,7 +24,7 @@ rule merge_runs:
         features=lambda w: step_features(w.step),
     output:
         design=step_path("{step}", "design.parquet"),
-        features=[step_path("{step}", "features", f"{shot}.parquet") for shot in SHOTS],
+        features=[step_path("{step}", "features", f"{shot}.parquet") for shot in BASE_SHOTS],
     log:
         f"{LOGS}/waves/step{{step}}/merge_runs.log",
     benchmark:
@@ -34,8 +34,8 @@ rule merge_runs:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(config, "merge_runs"),
-        pairs=lambda w, input: pairs(SHOTS * (int(w.step) + 1), input.features),
+        settings=stage_config(BASE_STUDY, "merge_runs"),
+        pairs=lambda w, input: pairs(BASE_SHOTS * (int(w.step) + 1), input.features),
         out=lambda w: step_path(w.step),
     shell:
         "shockcal merge-runs --designs {input.designs} --features {params.pairs} --out {params.out} > {log} 2>&1"
@@ -59,8 +59,8 @@ rule wave_emulator:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]
     params:
-        settings=stage_config(config, "emulate"),
-        pairs=lambda w, input: pairs(SHOTS, input.features),
+        settings=stage_config(BASE_STUDY, "emulate"),
+        pairs=lambda w, input: pairs(BASE_SHOTS, input.features),
         out=lambda w, output: os.path.dirname(output.emulator),
     shell:
         "shockcal emulate --design {input.design} --features {params.pairs} --no-cv --out {params.out} > {log} 2>&1"
@@ -70,7 +70,7 @@ rule wave_calibrate:
     """The joint posterior of waves 0..step's emulator (a step before the last)."""
     input:
         emulator=rules.wave_emulator.output.emulator,
-        observed=rules.observed.output[0],
+        observed=rules.observed_base.output[0],
     output:
         samples=step_path("{step}", "posterior", "joint.parquet"),
         summary=step_path("{step}", "posterior", "joint_summary.parquet"),
@@ -85,9 +85,9 @@ rule wave_calibrate:
         "../envs/shockcal.yaml"
     threads: 1  # as the study's calibrations (calibrate.smk)
     params:
-        settings=stage_config(config, "calibrate"),
+        settings=stage_config(BASE_STUDY, "calibrate"),
         sampler=STEP_SAMPLER,
-        shots=" ".join(SHOTS),
+        shots=" ".join(BASE_SHOTS),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
         "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots} {params.sampler}"
@@ -110,7 +110,7 @@ rule wave_design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(config, "wave_design"),
+        settings=stage_config(BASE_STUDY, "wave_design"),
         earlier=lambda w, input: f"--earlier-summary {input.earlier}" if "earlier" in input.keys() else "",
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
@@ -119,12 +119,33 @@ rule wave_design:
         " --observed {input.observed} --out {output} > {log} 2>&1"
 
 
-# the study's emulator (emulator.smk) is fitted on these runs
+rule new_shot_design:
+    """A new shot's design (design.new_shots): the base shots' joint posterior of the last step (step 0, the
+    training runs alone, without waves) thinned, the shot's own inputs drawn fresh. Its settings are the base
+    study's and this shot's alone (`new_shot_config`), so adding another shot reruns none of its runs."""
+    input:
+        posterior=rules.wave_calibrate.output.samples.format(step=LAST_STEP),
+        runs=rules.merge_runs.output.design.format(step=LAST_STEP),
+    output:
+        run_set_path("new_shot", "designs", "{shot}.parquet"),
+    log:
+        f"{LOGS}/new_shot/design/{{shot}}.log",
+    benchmark:
+        f"{BENCHMARKS}/new_shot/design/{{shot}}.tsv"
+    wildcard_constraints:
+        shot="|".join(NEW_SHOTS) or "^$",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        settings=lambda w: stage_config(new_shot_config(config, w.shot), "new_shot_design", w.shot),
+    shell:
+        "shockcal new-shot-design --shot {wildcards.shot} --posterior {input.posterior} --runs {input.runs}"
+        " --out {output} > {log} 2>&1"
+
+
+# the study's emulator (emulator.smk) is fitted on these runs: the base shots' on one design, each new shot's on its own
 STUDY_RUNS = {
     "design": rules.merge_runs.output.design.format(step=LAST_STEP) if WAVES else DESIGN,
-    "features": (
-        [step_path(LAST_STEP, "features", f"{shot}.parquet") for shot in SHOTS]
-        if WAVES
-        else expand(rules.features.output[0], run_set="training", shot=SHOTS)
-    ),
+    "features": [study_features(shot) for shot in SHOTS],
+    "shot_designs": [run_set_path("new_shot", "designs", f"{shot}.parquet") for shot in NEW_SHOTS],
 }

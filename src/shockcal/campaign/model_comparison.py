@@ -25,13 +25,14 @@ from shockcal.errors import InputError
 REFERENCE_MODEL = "johnson-cook"
 COLUMNS = ["model", "n_params", "log_z", "log_z_sd", "log_bf_vs_johnson_cook", "log_bf_sd", "n_box_params",
            "log_z_box_half", "log_z_box_half_sd", "log_z_box_double", "posterior_mass_near_faces", "kfold_rmse_m_s",
-           "outer_rmse_m_s"]
+           "outer_rmse_m_s", "heldout_rmse_m_s", "heldout_coverage"]
 
 
 class ModelResult(NamedTuple):
     """One law's study: its joint posterior's calibrated inputs, log evidence and sd, the measured
     features it was calibrated on (m/s), its emulator's K-fold and outer-check RMSE over all shots
-    and features (m/s), and the evidence's sensitivity to its box."""
+    and features (m/s), the evidence's sensitivity to its box, and its emulator's RMSE (m/s) and 90%
+    band coverage on the posterior's predictive runs, which no fit saw (NaN without them)."""
 
     parameters: tuple[str, ...]
     log_z: float
@@ -40,6 +41,8 @@ class ModelResult(NamedTuple):
     kfold_rmse_m_s: float
     outer_rmse_m_s: float
     box: BoxSensitivity
+    heldout_rmse_m_s: float = math.nan
+    heldout_coverage: float = math.nan
 
 
 def evidence_table(results: Mapping[str, ModelResult]) -> pd.DataFrame:
@@ -61,5 +64,6 @@ def evidence_table(results: Mapping[str, ModelResult]) -> pd.DataFrame:
                      "n_box_params": result.box.k, "log_z_box_half": result.box.log_z_half,
                      "log_z_box_half_sd": result.box.log_z_half_sd, "log_z_box_double": result.box.log_z_double,
                      "posterior_mass_near_faces": result.box.mass_near_faces,
-                     "kfold_rmse_m_s": result.kfold_rmse_m_s, "outer_rmse_m_s": result.outer_rmse_m_s})
+                     "kfold_rmse_m_s": result.kfold_rmse_m_s, "outer_rmse_m_s": result.outer_rmse_m_s,
+                     "heldout_rmse_m_s": result.heldout_rmse_m_s, "heldout_coverage": result.heldout_coverage})
     return pd.DataFrame(rows, columns=COLUMNS)

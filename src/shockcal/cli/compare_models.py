@@ -3,8 +3,10 @@
 Reads, per `--model NAME=RESULTS_DIR`: RESULTS_DIR/posterior/joint.parquet's metadata (calibrated inputs,
 log evidence and its sd, the measured features), RESULTS_DIR/posterior/joint_weighted.parquet (the
 sampler's weighted draws, for the box sensitivity), RESULTS_DIR/emulator/emulator.json's input_bounds
-(the prior box the calibration used) and RESULTS_DIR/emulator/cv_rmse.csv (the K-fold and outer check's
-RMSE over all shots and features; the outer one empty when the emulator skipped it).
+(the prior box the calibration used), RESULTS_DIR/emulator/cv_rmse.csv (the K-fold and outer check's
+RMSE over all shots and features; the outer one empty when the emulator skipped it) and, when the study
+made it, RESULTS_DIR/report/emulator_heldout.csv (the emulator on the posterior's predictive runs, which no
+fit saw: RMSE and 90% band coverage over all of them; empty columns without it).
 Writes `--out` (CSV; shockcal.campaign.model_comparison.COLUMNS) and, with `--figures-dir`, the log evidence per law
 (evidence.png and .pdf).
 
@@ -69,7 +71,26 @@ def model_result(name: str, results_dir: str):
     observed = [float(v) for v in (observed.strip("[]").split(",") if isinstance(observed, str) else observed)]
     return ModelResult(tuple(meta["parameters"]), float(meta["log_evidence"]), float(meta["log_evidence_sd"]),
                        tuple(observed), float(overall["kfold"]), float(overall.get("outer", math.nan)),
-                       box_result(name, weighted, emulator))
+                       box_result(name, weighted, emulator),
+                       *heldout_scores(name, Path(results_dir) / "report" / "emulator_heldout.csv"))
+
+
+def heldout_scores(name: str, path) -> tuple[float, float]:
+    """(RMSE m/s, 90% band coverage) of the emulator over all of the posterior's predictive runs, from the
+    study's emulator_heldout.csv (`shockcal report-tables --heldout-*`); NaN, NaN when the study has none."""
+    import math
+
+    import pandas as pd
+
+    from shockcal.errors import InputError
+
+    if not path.is_file():
+        return math.nan, math.nan
+    table = pd.read_csv(path)
+    overall = table[table["feature"].astype(str).str.startswith("all (")] if "feature" in table else table.iloc[:0]
+    if overall.empty:
+        raise InputError(f"--model {name}: {path}: no 'all (N runs)' row")
+    return float(overall["rmse_m_s"].iloc[0]), float(overall["coverage"].iloc[0])
 
 
 VELOCITY_UNIT = "cm/us"      # a shot's velocity_input (config schema): excluded from the box

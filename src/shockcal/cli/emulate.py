@@ -27,6 +27,9 @@ def register(subparsers) -> None:
     p.add_argument("--design", required=True, help="design table (CSV or Parquet, Table IV units)")
     p.add_argument("--features", required=True, nargs="+", metavar="SHOT=FILE",
                    help="per-shot feature tables (CSV or Parquet), joined to the design on `run`")
+    p.add_argument("--shot-design", nargs="+", default=[], metavar="SHOT=FILE",
+                   help="a shot whose runs have a design of their own (a new shot's, design.new_shots): its "
+                        "features join that design, not --design's, and it gets an emulator block of its own")
     p.add_argument("--structure", choices=["per_shot", "joint"], help="override emulator.structure")
     p.add_argument("--first-runs", type=int, metavar="N",
                    help="fit on the design's first N rows only; the features of later runs are left out "
@@ -53,15 +56,17 @@ def run(args) -> int:
 
     from shockcal.emulator.study_emulator import fit_emulator
     from shockcal.io import read_table
-    from shockcal.study.adapters import emulator_spec, load_study_design
+    from shockcal.study.adapters import emulator_spec, inputs_read_by, load_study_design
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "emulate")
     paths = parse_pairs(args.features, "--features")
-    spec = emulator_spec(config, list(paths))
+    own = parse_pairs(args.shot_design, "--shot-design")
+    spec = replace(emulator_spec(config, list(paths)), own_blocks=tuple(own))
     if args.structure:
         spec = replace(spec, structure=args.structure)
-    design = load_study_design(args.design, config)
+    design = load_study_design(args.design, config, inputs_read_by(config, [s for s in paths if s not in own]))
+    shot_designs = {shot: load_study_design(path, config, inputs_read_by(config, [shot])) for shot, path in own.items()}
     features = {shot: read_table(path) for shot, path in paths.items()}
     if args.first_runs is not None:
         from shockcal.errors import InputError
@@ -72,7 +77,7 @@ def run(args) -> int:
         design = design.iloc[:args.first_runs]
         features = {shot: table[table["run"].isin(design["run"])] if "run" in table else table
                     for shot, table in features.items()}
-    emulator = fit_emulator(design, features, spec, sources=paths)
+    emulator = fit_emulator(design, features, spec, sources=paths, shot_designs=shot_designs)
     out = Path(args.out)
     emulator.save(out)
     if args.no_cv:

@@ -17,6 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from shockcal.design.tables import extend_design
 from shockcal.errors import InputError
 from shockcal.inference.predict import draw_posterior_design
 
@@ -111,3 +112,28 @@ def wave_design(posterior: pd.DataFrame, bounds: Mapping[str, tuple[float, float
     design = pool.iloc[rows][names].reset_index(drop=True)
     design.insert(0, "run", np.arange(first_run, first_run + n_runs, dtype=np.int64))
     return design
+
+
+def new_shot_design(posterior: pd.DataFrame, bounds: Mapping[str, tuple[float, float]],
+                    own_bounds: Mapping[str, tuple[float, float]], n_runs: int, first_run: int, seed: int,
+                    own_seeds: Mapping[str, int], existing: pd.DataFrame | None = None, widen: float = 1.0,
+                    pool_size: int = 4000, source: str = "posterior") -> pd.DataFrame:
+    """A shot added to a study: `n_runs` rows where the other shots' joint posterior lives, with the
+    shot's own inputs drawn fresh over their box.
+
+    The inputs of `bounds` (those the posterior has: the base shots') are the posterior thinned for
+    space filling away from `existing` (`wave_design`, criterion posterior_thinned); each input of
+    `own_bounds` (the new shot's impact velocity, a modulus increment only it reads) is a
+    one-dimensional Latin hypercube over the rows from its seed in `own_seeds` (`extend_design`).
+
+    Args:
+        posterior: the base shots' joint posterior, equal-weight draws (native units).
+        bounds: the prior box of the inputs drawn from it (native units), in column order.
+        own_bounds: the prior box of the shot's own inputs.
+        n_runs: rows; first_run: the first run id (ids unique over the study's runs).
+        seed: the posterior pool's seed; own_seeds: input -> its column's seed.
+        existing, widen, pool_size, source: as `wave_design`.
+    """
+    design = wave_design(posterior, bounds, n_runs, first_run, seed, existing=existing, widen=widen,
+                         pool_size=pool_size, source=source)
+    return extend_design(design, own_bounds, own_seeds)

@@ -6,6 +6,7 @@ structures (`EmulatorSpec.structure`, config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
+A shot in `EmulatorSpec.own_blocks` (a new shot with runs of its own) gets a block of its own in either.
 An `InputMap` says how a block's inputs derive from design columns (sums, and the powers eps^n and T*^m).
 
 Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units,
@@ -105,13 +106,16 @@ def _box_map(bounds, names, terms, powers) -> InputMap:
 class EmulatorSpec:
     """What the study's emulator is fitted over: its structure (`per_shot` or `joint`), how each shot
     reads the design, the prior box by design input (native units), the extra power inputs (base,
-    design column; `InputMap`) and the GP settings, whose seed keys each block's own random stream."""
+    design column; `InputMap`), the GP settings, whose seed keys each block's own random stream, and the
+    shots fitted on a block of their own in either structure (`own_blocks`: a new shot whose runs are not
+    the other shots' rows, `design.new_shots`)."""
 
     structure: str
     shots: Mapping[str, ShotMapping]
     bounds: Mapping[str, tuple[float, float]]
     powers: tuple[tuple[float, str], ...] = ()
     settings: Settings = field(default_factory=Settings)
+    own_blocks: tuple[str, ...] = ()
 
 
 @dataclass
@@ -366,7 +370,8 @@ def _check_training_inputs(table: pd.DataFrame, input_map: InputMap, label: str)
 
 
 def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: EmulatorSpec,
-                 sources: dict[str, str] | None = None) -> Emulator:
+                 sources: dict[str, str] | None = None,
+                 shot_designs: Mapping[str, pd.DataFrame] | None = None) -> Emulator:
     """Fit the study's emulator; block i fits with stream ("emulator", i) of `spec.settings.seed`.
 
     Args:
@@ -375,6 +380,8 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
             joined to the design on `run`; failed or NaN runs are dropped with a logged count.
         spec: structure, shot mappings, prior box, power inputs and GP settings (`EmulatorSpec`).
         sources: shot -> where its table came from, for messages.
+        shot_designs: shot -> a design of its own (a shot of `spec.own_blocks`), joined to its features
+            instead of `design`.
     """
     shots = list(features)
     unmapped = [shot for shot in shots if shot not in spec.shots]
@@ -382,17 +389,20 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
         raise InputError(f"features of shots {unmapped}: the emulator spec maps only {list(spec.shots)}")
     mappings = [spec.shots[shot] for shot in shots]
     sources = sources or {shot: f"features of {shot}" for shot in shots}
-    tables = {shot: training_data(design, features[shot], shot, sources[shot]) for shot in shots}
-    if spec.structure == "per_shot":
-        groups = [([m.shot], shot_input_map(m, spec.bounds, spec.powers), tables[m.shot], sources[m.shot],
-                   CALIBRATION_FEATURES) for m in mappings]
-    else:
-        joined = tables[shots[0]].rename(columns={f: f"{shots[0]}:{f}" for f in CALIBRATION_FEATURES})
-        for shot in shots[1:]:
+    shot_designs = shot_designs or {}
+    tables = {shot: training_data(shot_designs.get(shot, design), features[shot], shot, sources[shot]) for shot in shots}
+    together = [m for m in mappings if m.shot not in spec.own_blocks]
+    groups = []
+    if spec.structure == "joint" and together:
+        names = [m.shot for m in together]
+        joined = tables[names[0]].rename(columns={f: f"{names[0]}:{f}" for f in CALIBRATION_FEATURES})
+        for shot in names[1:]:
             joined = joined.merge(tables[shot][["run", *CALIBRATION_FEATURES]].rename(
                 columns={f: f"{shot}:{f}" for f in CALIBRATION_FEATURES}), on="run", how="inner")
-        groups = [(shots, joint_input_map(mappings, spec.bounds, spec.powers), joined, "joint training set",
-                   [f"{s}:{f}" for s in shots for f in CALIBRATION_FEATURES])]
+        groups.append((names, joint_input_map(together, spec.bounds, spec.powers), joined, "joint training set",
+                       [f"{s}:{f}" for s in names for f in CALIBRATION_FEATURES]))
+    groups += [([m.shot], shot_input_map(m, spec.bounds, spec.powers), tables[m.shot], sources[m.shot],
+                CALIBRATION_FEATURES) for m in mappings if spec.structure == "per_shot" or m.shot in spec.own_blocks]
     blocks = []
     for i, (block_shots, input_map, table, label, columns) in enumerate(groups):
         _check_training_inputs(table, input_map, label)

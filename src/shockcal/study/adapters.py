@@ -186,9 +186,55 @@ def load_study_design(path, config: dict, columns: list[str] | None = None, allo
 def base_inputs(config: dict) -> list[str]:
     """The inputs the design's Latin hypercube spans, in config order: those of `design.base_shots`
     (every shot when null). An input only a later shot reads gets a column of its own (`study_design`)."""
-    base_shots = config["design"]["base_shots"] or list(config["shots"])
-    used = {name for shot in base_shots for name in shot_mapping(config, shot).inputs()}
+    return inputs_read_by(config, config["design"]["base_shots"] or list(config["shots"]))
+
+
+def inputs_read_by(config: dict, shots) -> list[str]:
+    """The design columns `shots` read, in config order."""
+    used = {name for shot in shots for name in shot_mapping(config, shot).inputs()}
     return [name for name in config["inputs"] if name in used]
+
+
+def new_posterior_shots(config: dict) -> list[str]:
+    """The shots outside `design.base_shots` whose runs come from the base shots' joint posterior
+    (`design.new_shots.runs_from: posterior`), in config order; none when base_shots is null."""
+    base = config["design"]["base_shots"]
+    if not base or config["design"]["new_shots"]["runs_from"] != "posterior":
+        return []
+    return [shot for shot in config["shots"] if shot not in base]
+
+
+def base_study_config(config: dict) -> dict:
+    """The study as its base shots (`design.base_shots`) alone make it: the other shots, their records
+    and published features, the inputs only they read and the next-shot candidates referring to them
+    left out. The base shots' emulator and joint posterior, which place a new shot's runs, are computed
+    under it, so adding a shot changes none of their settings."""
+    import copy
+
+    base = config["design"]["base_shots"] or list(config["shots"])
+    kept = set(base_inputs(config))
+    study = copy.deepcopy(config)
+    study["shots"] = {shot: spec for shot, spec in study["shots"].items() if shot in base}
+    study["inputs"] = {name: spec for name, spec in study["inputs"].items() if name in kept}
+    for key in ("records", "features"):
+        if isinstance(study["observed"].get(key), dict):
+            study["observed"][key] = {shot: v for shot, v in study["observed"][key].items() if shot in base}
+    study["next_shot"]["candidates"] = {name: spec for name, spec in study["next_shot"]["candidates"].items()
+                                        if spec.get("shot") in base}
+    return study
+
+
+def new_shot_config(config: dict, shot: str) -> dict:
+    """`base_study_config` with the new shot `shot` (its inputs and record) back in: what that shot's
+    design and runs read, so that adding another shot reruns neither."""
+    study = base_study_config(config)
+    study["shots"][shot] = config["shots"][shot]
+    read = set(study["inputs"]) | set(shot_mapping(config, shot).inputs())
+    study["inputs"] = {name: spec for name, spec in config["inputs"].items() if name in read}
+    for key in ("records", "features"):
+        if isinstance(config["observed"].get(key), dict) and shot in config["observed"][key]:
+            study["observed"][key][shot] = config["observed"][key][shot]
+    return study
 
 
 def extension_inputs(config: dict) -> dict[str, str]:

@@ -65,6 +65,9 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
     "wave_design": ("study.seed", "design.strategy", "design.waves", "observed.sd_fraction", "inputs",
                     "checks.design_box", *_SHOT_MAPPING),
+    # a new shot's design (design.new_shots): the base shots' joint posterior thinned, its own inputs drawn
+    "new_shot_design": ("study.seed", "design.base_shots", "design.new_shots", "design.waves.widen",
+                        "design.waves.pool_size", "inputs", "checks.design_box", *_SHOT_MAPPING),
     # every run of a sequential study so far, one design and one features table per shot
     "merge_runs": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # the posterior rows run through the hydrocode for predictions
