@@ -121,7 +121,7 @@ def test_a_new_shot_runs_only_its_own_rows_placed_by_the_base_shots_posterior(tm
     more = shot_overlay(tmp_path, tmp_path / "results")
     jobs = pending_jobs(QUICK, more)
     assert jobs["simulate"] == 3 * 4                                    # the base shots' 40 training runs only
-    assert jobs["simulate[new_shot]"] == 2 and jobs["features[new_shot]"] == 1     # 107S's 20 runs
+    assert jobs["simulate[new_shot]"] == 4 and jobs["features[new_shot]"] == 1     # 107S's 20 runs in 4 chunks
     assert jobs["new_shot_design"] == jobs["observed_base"] == 1
     assert jobs["merge_runs"] == jobs["wave_emulator"] == jobs["wave_calibrate"] == 1
     out = snakemake("all", "--dry-run", "--printshellcmds", config_files=[QUICK, more]).stdout
@@ -140,4 +140,4 @@ def test_a_sequential_studys_waves_are_placed_for_the_base_shots_alone(tmp_path)
     jobs = pending_jobs(SEQUENTIAL, waves, more)
     assert jobs["simulate"] == 3 * 3 and jobs["simulate[wave1]"] == jobs["simulate[wave2]"] == 3
     assert jobs["wave_emulator"] == jobs["wave_calibrate"] == 3 and jobs["merge_runs"] == 3
-    assert jobs["simulate[new_shot]"] == 2 and jobs["new_shot_design"] == 1
+    assert jobs["simulate[new_shot]"] == 4 and jobs["new_shot_design"] == 1

@@ -128,8 +128,9 @@ def simulate_priority(wildcards):
     if wildcards.shot not in SHOTS:
         return SIMULATE_PRIORITY
     size = RUN_SET_SIZES[wildcards.run_set]
-    rows = min(CHUNK_SIZE, size - int(wildcards.chunk) * CHUNK_SIZE)
-    longest = min(CHUNK_SIZE, size) * max(run_cost_mm_us(config, shot, wildcards.run_set) for shot in SHOTS)
+    chunk_size = RUN_SET_CHUNK_SIZE[wildcards.run_set]
+    rows = min(chunk_size, size - int(wildcards.chunk) * chunk_size)
+    longest = min(chunk_size, size) * max(run_cost_mm_us(config, shot, wildcards.run_set) for shot in SHOTS)
     cost = rows * run_cost_mm_us(config, wildcards.shot, wildcards.run_set)
     return SIMULATE_PRIORITY + round(PRIORITY_STEPS * cost / longest)
 

@@ -63,4 +63,9 @@ RUN_SET_SIZES["next_shot_truth"] = config["next_shot"]["check"]["n_truths"]
 #   new_shot: design.new_shots.n_runs rows per new shot, from the base shots' joint posterior (waves.smk), each
 #             shot's own design ({RESULTS}/new_shot/designs/<shot>.parquet)
 RUN_SET_SIZES["new_shot"] = config["design"]["new_shots"]["n_runs"]
-RUN_SET_CHUNKS = {name: list(range(chunk_count(n, CHUNK_SIZE))) for name, n in RUN_SET_SIZES.items()}
+# Rows per simulate chunk: simulate.chunk_size; a new shot's, one shot alone, in NEW_SHOT_CHUNKS chunks at most that
+# size, so that its runs fill the cores (150 runs in one chunk of the paper study's 150 kept one core idle)
+NEW_SHOT_CHUNKS = 4
+RUN_SET_CHUNK_SIZE = {name: CHUNK_SIZE for name in RUN_SET_SIZES}
+RUN_SET_CHUNK_SIZE["new_shot"] = min(CHUNK_SIZE, chunk_count(RUN_SET_SIZES["new_shot"], NEW_SHOT_CHUNKS))
+RUN_SET_CHUNKS = {name: list(range(chunk_count(n, RUN_SET_CHUNK_SIZE[name]))) for name, n in RUN_SET_SIZES.items()}

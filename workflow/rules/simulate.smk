@@ -23,7 +23,9 @@ rule simulate:
     params:
         settings=run_set_settings("simulate"),
         rows=lambda w: chunk_rows(
-            w.chunk, CHUNK_SIZE, RUN_SET_SIZES[w.run_set] if w.run_set == "next_shot_check" else None
+            w.chunk,
+            RUN_SET_CHUNK_SIZE[w.run_set],
+            RUN_SET_SIZES[w.run_set] if w.run_set == "next_shot_check" else None,
         ),
         rows_digest=lambda w: (
             CHUNK_DIGESTS[w.shot][int(w.chunk)]
