@@ -191,8 +191,9 @@ def test_added_shot_runs_only_its_simulations(study, tmp_path):
     record = _own_record(quick, tmp_path)                        # a fourth shot comes with its record
     more = overlay(tmp_path / "shot.yaml", shots={"107S": new_shot}, observed={"records": {"107S": record}})
     jobs = pending_jobs(study[1], more)
-    assert jobs["simulate"] == 4 and jobs["features_chunk"] == 4     # the 4 chunks of 107S only
-    assert jobs["features"] == 1
+    assert "simulate" not in jobs and "features" not in jobs          # no training run reruns
+    assert jobs["simulate[new_shot]"] == jobs["features_chunk[new_shot]"] == 4 and jobs["features[new_shot]"] == 1
+    assert jobs["wave_emulator"] == jobs["wave_calibrate"] == 1       # the base shots' step 0 places 107S's runs
 
 
 def _own_record(config, tmp_path) -> dict:
