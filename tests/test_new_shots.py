@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 from test_emulator import _synthetic_study
 from test_workflow import _own_record, overlay, pending_jobs, snakemake
 
@@ -141,3 +142,25 @@ def test_a_sequential_studys_waves_are_placed_for_the_base_shots_alone(tmp_path)
     assert jobs["simulate"] == 3 * 3 and jobs["simulate[wave1]"] == jobs["simulate[wave2]"] == 3
     assert jobs["wave_emulator"] == jobs["wave_calibrate"] == 3 and jobs["merge_runs"] == 3
     assert jobs["simulate[new_shot]"] == 4 and jobs["new_shot_design"] == 1
+
+
+@pytest.mark.slow   # a sequential toy study with a new shot, to its joint posterior: about 4 min on 2 cores
+def test_a_new_shot_in_a_sequential_study_end_to_end(tmp_path):
+    """Waves placed for the base shots (their designs without the new shot's inputs), the last step placing the
+    new shot's 20 runs, and the four-shot joint posterior from an emulator with the new shot's block."""
+    results = tmp_path / "results"
+    waves = overlay(tmp_path / "waves.yaml", study={"results_dir": str(results)})
+    more = shot_overlay(tmp_path, results)
+    done = snakemake(str(results / "posterior" / "joint.parquet"), "--cores", "2",
+                     config_files=[SEQUENTIAL, waves, more], check=False)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    for wave in (1, 2):
+        design = pd.read_parquet(results / f"wave{wave}" / "design.parquet")
+        assert len(design) == 10 and "V4" not in design.columns
+    new = pd.read_parquet(results / "new_shot" / "designs" / "107S.parquet")
+    runs = pd.read_parquet(results / "waves" / "step2" / "design.parquet")
+    assert len(new) == 20 and new["run"].min() == runs["run"].max() + 1
+    posterior = pd.read_parquet(results / "posterior" / "joint.parquet")
+    assert {"V4", "Delta4", "V3"} <= set(posterior.columns)
+    step = pd.read_parquet(results / "waves" / "step2" / "posterior" / "joint.parquet")
+    assert "V4" not in step.columns

@@ -34,6 +34,8 @@ def test_fifteen_figures_in_the_papers_order(paper_config):
     assert [int(name[3:5]) for name in names[:15]] == list(range(1, 16))
     assert history_names(paper_config) == {"fig11_history_104S": "104S", "fig12_history_105S": "105S",
                                            "fig13_history_106S": "106S"}
+    added_first = {**paper_config, "shots": {"107S": paper_config["shots"]["106S"], **paper_config["shots"]}}
+    assert history_names(added_first) == history_names(paper_config)   # snakemake's merge put an overlay's shot first
 
 
 @pytest.mark.parametrize("name", [n for n in catalogue({"shots": {"104S": {}, "105S": {}, "106S": {}}}) if n not in TOYS])

@@ -83,7 +83,10 @@ def run_wave_design(args) -> int:
     if not 1 <= args.wave < len(sizes):
         raise InputError(f"--wave: {args.wave} is not a later wave of this study (1 to {len(sizes) - 1})")
     n_runs, stopped = sizes[args.wave], ""
-    if load_study_design(args.previous_design, config, allow_empty=True).empty:
+    posterior = read_table(args.posterior)
+    # the inputs of the calibrated shots: a new shot's own (design.new_shots) are not in the posterior, nor drawn
+    bounds = {name: box for name, box in prior_bounds(config).items() if name in posterior.columns}
+    if load_study_design(args.previous_design, config, list(bounds), allow_empty=True).empty:
         stopped = f"the previous wave ({args.previous_design}) is empty: the study stopped before it"
     elif args.earlier_summary:
         before, after = read_table(args.earlier_summary), read_table(companion_path(args.posterior))
@@ -93,9 +96,6 @@ def run_wave_design(args) -> int:
         if posterior_settled(before, after, waves["stop_mcse"], user_box_widths(config), waves["stop_box"]):
             stopped = (f"no 5/50/95% point moved by max({waves['stop_mcse']:g} combined Monte Carlo SE, "
                        f"{waves['stop_box']:g} of its box) or more (design.waves.stop_mcse, stop_box)")
-    posterior = read_table(args.posterior)
-    # the inputs of the calibrated shots: a new shot's own (design.new_shots) are not in the posterior, nor drawn
-    bounds = {name: box for name, box in prior_bounds(config).items() if name in posterior.columns}
     runs = load_study_design(args.runs, config, list(bounds))
     variance = None
     if waves["criterion"] == "max_variance" and not stopped:

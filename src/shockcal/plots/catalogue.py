@@ -91,7 +91,9 @@ class FigureSpec:
 
 
 def _shots(config) -> list[str]:
-    return list(config["shots"])
+    """The shots by name: the order every job's config has (the workflow writes it with sorted keys), whatever
+    order snakemake's config merge gave the Snakefile (a shot added by an overlay came first there)."""
+    return sorted(config["shots"])
 
 
 def _toy(name, inputs, config):
@@ -179,7 +181,7 @@ def _next_shot(inputs, config):
 
 
 def history_names(config) -> dict[str, str]:
-    """{figure name: shot} for Figs 11-13 (the first three shots of the config)."""
+    """{figure name: shot} for Figs 11-13 (the first three shots by name)."""
     return {f"fig{11 + i}_history_{shot}": shot for i, shot in enumerate(_shots(config)[:3])}
 
 
