@@ -14,10 +14,11 @@ import numpy as np
 import pandas as pd
 import pytest
 from test_emulator import _synthetic_study
-from test_workflow import _own_record, overlay, pending_jobs, snakemake
+from test_workflow import _own_record, job_counts, overlay, pending_jobs, snakemake
 
 from shockcal.design.waves import new_shot_design
 from shockcal.emulator.study_emulator import fit_emulator
+from shockcal.errors import ConfigError
 from shockcal.study.adapters import base_study_config, emulator_spec, new_posterior_shots, new_shot_config
 from shockcal.study.config import prior_bounds
 from shockcal.study.stages import stage_config
@@ -102,10 +103,10 @@ def test_the_new_shot_design_command_refuses_a_base_shot_in_one_line(tmp_path):
     assert "--shot: 104S is not a new shot" in done.stderr
 
 
-def test_a_new_shot_with_one_run_is_refused_naming_the_key(tmp_path):
-    bad = overlay(tmp_path / "bad.yaml", design={"new_shots": {"n_runs": 1}})
-    done = snakemake("all", "--dry-run", config_files=[bad], check=False)
-    assert done.returncode != 0 and "design.new_shots.n_runs" in done.stdout + done.stderr
+def test_a_new_shot_with_one_run_is_refused_naming_the_key(paper_config):
+    paper_config["design"]["new_shots"] = {"n_runs": 1}
+    with pytest.raises(ConfigError, match=r"design\.new_shots\.n_runs: 1 is less than the minimum of 2"):
+        validate_config(paper_config)
 
 
 def shot_overlay(tmp_path: Path, results: Path, **design) -> Path:
@@ -120,12 +121,12 @@ def test_a_new_shot_runs_only_its_own_rows_placed_by_the_base_shots_posterior(tm
     """A Latin-hypercube study: the base shots' emulator and joint posterior on the training runs (step 0) place
     the new shot's 20 runs; it runs no training row, and the study's emulator gets its design."""
     more = shot_overlay(tmp_path, tmp_path / "results")
-    jobs = pending_jobs(QUICK, more)
+    out = snakemake("all", "--dry-run", "--printshellcmds", config_files=[more]).stdout
+    jobs = job_counts(out)
     assert jobs["simulate"] == 3 * 4                                    # the base shots' 40 training runs only
     assert jobs["simulate[new_shot]"] == 4 and jobs["features[new_shot]"] == 1     # 107S's 20 runs in 4 chunks
     assert jobs["new_shot_design"] == jobs["observed_base"] == 1
     assert jobs["merge_runs"] == jobs["wave_emulator"] == jobs["wave_calibrate"] == 1
-    out = snakemake("all", "--dry-run", "--printshellcmds", config_files=[QUICK, more]).stdout
     step = next(line for line in out.splitlines() if "shockcal calibrate" in line and "waves/step0" in line)
     assert "--shots 104S 105S 106S " in step
     study = next(line for line in out.splitlines() if "shockcal emulate" in line and "waves" not in line)

@@ -52,7 +52,11 @@ def pending_jobs(*config_files, target="all") -> dict[str, int]:
     """Rule -> number of jobs a dry run of `target` would execute (empty when nothing is to be done).
     Jobs of the run-set rules count under the rule's name for the training runs and under
     "rule[run set]" for the others ("simulate[predict]"), so a rerun of training runs stays visible."""
-    out = snakemake(target, "--dry-run", config_files=config_files).stdout
+    return job_counts(snakemake(target, "--dry-run", config_files=config_files).stdout)
+
+
+def job_counts(out: str) -> dict[str, int]:
+    """`pending_jobs`' count from a dry run's output."""
     if "Job stats:" not in out:
         assert "Nothing to be done" in out, out[-2000:]
         return {}
