@@ -48,6 +48,7 @@ def test_models_reduced_runs_each_law_to_its_predictive_runs(tmp_path):
     assert "rule posterior_netcdf:" in dry.stdout and "rule report_heldout:" in dry.stdout
 
 
+@pytest.mark.slow   # 4 s; the Makefile's wiring is the same as models-reduced's (the test above)
 def test_models_sequential_runs_each_law_in_waves(tmp_path):
     """`make models-sequential`: config/sequential.yaml over the paper's config, each law's runs in waves (its
     steps' emulators and posteriors), to its joint posterior and its emulator scored on the predictive runs."""
