@@ -205,35 +205,32 @@ def new_posterior_shots(config: dict) -> list[str]:
 
 
 def base_study_config(config: dict) -> dict:
-    """The study as its base shots (`design.base_shots`) alone make it: the other shots, their records
-    and published features, the inputs only they read and the next-shot candidates referring to them
-    left out. The base shots' emulator and joint posterior, which place a new shot's runs, are computed
-    under it, so adding a shot changes none of their settings."""
-    import copy
-
-    base = config["design"]["base_shots"] or list(config["shots"])
-    kept = set(base_inputs(config))
-    study = copy.deepcopy(config)
-    study["shots"] = {shot: spec for shot, spec in study["shots"].items() if shot in base}
-    study["inputs"] = {name: spec for name, spec in study["inputs"].items() if name in kept}
-    for key in ("records", "features"):
-        if isinstance(study["observed"].get(key), dict):
-            study["observed"][key] = {shot: v for shot, v in study["observed"][key].items() if shot in base}
-    study["next_shot"]["candidates"] = {name: spec for name, spec in study["next_shot"]["candidates"].items()
-                                        if spec.get("shot") in base}
-    return study
+    """The study as its base shots (`design.base_shots`) alone make it (`study_of_shots`). The base
+    shots' emulator and joint posterior, which place a new shot's runs, are computed under it, so adding a
+    shot changes none of their settings."""
+    return study_of_shots(config, config["design"]["base_shots"] or list(config["shots"]))
 
 
 def new_shot_config(config: dict, shot: str) -> dict:
-    """`base_study_config` with the new shot `shot` (its inputs and record) back in: what that shot's
-    design and runs read, so that adding another shot reruns neither."""
-    study = base_study_config(config)
-    study["shots"][shot] = config["shots"][shot]
-    read = set(study["inputs"]) | set(shot_mapping(config, shot).inputs())
-    study["inputs"] = {name: spec for name, spec in config["inputs"].items() if name in read}
+    """The base study with the new shot `shot` back in: what that shot's design and runs read, so that
+    adding another shot reruns neither."""
+    return study_of_shots(config, [*(config["design"]["base_shots"] or []), shot])
+
+
+def study_of_shots(config: dict, shots) -> dict:
+    """`config` with only `shots`: the other shots, their records and published features, the inputs
+    only they read and the next-shot candidates referring to them left out."""
+    import copy
+
+    kept = set(inputs_read_by(config, shots))
+    study = copy.deepcopy(config)
+    study["shots"] = {shot: spec for shot, spec in study["shots"].items() if shot in shots}
+    study["inputs"] = {name: spec for name, spec in study["inputs"].items() if name in kept}
     for key in ("records", "features"):
-        if isinstance(config["observed"].get(key), dict) and shot in config["observed"][key]:
-            study["observed"][key][shot] = config["observed"][key][shot]
+        if isinstance(study["observed"].get(key), dict):
+            study["observed"][key] = {shot: v for shot, v in study["observed"][key].items() if shot in shots}
+    study["next_shot"]["candidates"] = {name: spec for name, spec in study["next_shot"]["candidates"].items()
+                                        if spec.get("shot") in shots}
     return study
 
 
