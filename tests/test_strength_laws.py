@@ -24,13 +24,16 @@ from scipy.integrate import solve_ivp
 from scipy.special import erf
 
 from shockcal.cli import main
+from shockcal.errors import InputError
 from shockcal.hydro.laws import LAWS, code_parameters, flow_stress_curve, get_law, shear_modulus_gpa
 from shockcal.hydro.laws.boxes import load_boxes
+from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
 from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
 from shockcal.hydro.laws.steinberg_guinan import steinberg_guinan_melt_temperature, steinberg_guinan_shear_modulus
-from shockcal.hydro.plastic_return import homologous_temperature
+from shockcal.hydro.plastic_return import LAW_FLOOR_SLACK, homologous_temperature
 from shockcal.hydro.state import Material
 from shockcal.hydro.strength import equivalent_strain_rate, flow_stress, hardening, thermal_factor
+from shockcal.units import PER_S_TO_PER_US
 
 RTOL = 1e-10
 STRAINS = np.array([0.0, 1e-4, 0.003, 0.02, 0.05, 0.1, 0.2, 0.5])
@@ -326,6 +329,46 @@ def test_steinberg_guinan_against_impala(impala_functions):
                                          G, STRAINS.copy(), _array(T, size), _array(T_melt, size))
             worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, 1.0, T), impala * 1e3))
     assert worst <= 1e-10
+
+
+# ---------------------------------------------------------------------------------------------- 3b. solver floors
+def _box_draws(name: str, count: int, rng) -> list[dict]:
+    """Parameter sets drawn uniformly from the law's prior box (config/models.yaml), constraints met."""
+    box, law, sets = load_boxes()[name], get_law(name), []
+    while len(sets) < count:
+        values = {k: rng.uniform(b.low, b.high) for k, b in box.items()}
+        try:
+            sets.append((values, code_parameters(law, values)))
+        except InputError:
+            continue
+    return sets
+
+
+@pytest.mark.parametrize("name", ["steinberg-guinan", "ptw", "zerilli-armstrong"])
+def test_law_floor_lies_below_the_flow_stress(name):
+    """The solver skips a law's flow stress while the elastic trial lies inside its floor
+    (`law_flow_stress_floor`, from the cached `law_hardening`): exact only if the floor never exceeds
+    the flow stress. Checked over 40 parameter sets drawn from the prior box and 400 states each, with
+    strain rates from 0 to 1e9 /s (PTW's r far above 1, its overdriven branches), temperatures to the
+    melt, compressions and tensions; and the flow stress with the cell's G (`law_flow_stress_at`)
+    equals the law's own bit for bit."""
+    law = get_law(name)
+    rng = np.random.default_rng(20261128)
+    hits = 0
+    for _, code in _box_draws(name, 40, rng):
+        for _ in range(400):
+            eps_p = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 0)
+            rate = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 9) * PER_S_TO_PER_US
+            T, P, eta = rng.uniform(1.0, 1000.0), rng.uniform(-0.01, 0.15), rng.uniform(0.85, 1.4)
+            G = law_shear_modulus(code, 0.27, P, T, eta)
+            if G <= 0.0:
+                continue
+            Y = law.flow_stress(code, eps_p, rate, T, P, eta)
+            assert law_flow_stress_at(code, G, eps_p, rate, T, P, eta) == Y
+            floor = law_flow_stress_floor(code, law_hardening(code, eps_p), G, rate, T, eta)
+            assert LAW_FLOOR_SLACK * floor <= Y, (code, eps_p, rate, T, P, eta, floor, Y)
+            hits += floor > 0.5 * Y
+    assert hits > 1000          # the floor is not vacuous: it reaches half the flow stress in many states
 
 
 # ---------------------------------------------------------------------------------------------- 4. declarations

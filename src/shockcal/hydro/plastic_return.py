@@ -3,7 +3,10 @@
 Johnson-Cook (`Strength`) is evaluated only when the trial leaves the cell's flow-stress floor (`floor_at`,
 `new_floors`, `inside_floor`): a lower bound of (A + B eps_p^n)(1 - T*^m), valid while the cell is no hotter
 than when the floor was set (`FLOOR_MARGIN_K` more for the hotter floor), so an elastic cell costs no pow or
-log. Any other law (`LawStrength`) is evaluated every step. `plastic_return`, `cell_shear_modulus` and
+log. Any other law (`LawStrength`) is evaluated only when the trial leaves the law's floor
+(`law_flow_stress_floor`: Steinberg-Guinan's exact flow stress, PTW's quasi-static one while r <= 1,
+Zerilli-Armstrong's C0), read from the hardening the cell caches in `hard`. Both skips are exact: a
+skipped cell is one the full evaluation would have left elastic. `plastic_return`, `cell_shear_modulus` and
 `initial_hardening` pick their branch when numba compiles, by the type of the strength tuple, and are inlined
 into the solver's `update_cells`.
 """
@@ -13,7 +16,7 @@ from __future__ import annotations
 from numba import njit
 from numba.extending import overload
 
-from shockcal.hydro.laws.kernels import law_flow_stress, law_shear_modulus
+from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
 from shockcal.hydro.state import Strength
 from shockcal.hydro.strength import (
     equivalent_strain_rate,
@@ -27,6 +30,7 @@ from shockcal.hydro.strength import (
 
 FLOOR_MARGIN_K = 1.0       # a cell's flow-stress floor holds up to this much above the temperature it was set at
 FLOOR_SLACK = 1.0 - 1e-12  # keeps the floor below the flow stress through rounding (products in another order)
+LAW_FLOOR_SLACK = 1.0 - 1e-9  # the same for a law's floor, computed along another path than its flow stress
 
 
 @njit(cache=True, error_model="numpy")
@@ -97,15 +101,21 @@ def johnson_cook_floored_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, 
 
 def law_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
                material):
-    """Any law (`LawStrength`): the trial returned onto the law's flow stress at the cell's plastic strain,
-    equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, evaluated every
-    step (no floor; `hard` and the floors pass through), with the cell's shear modulus G (Mbar). A cell
-    with G = 0 (molten) carries no deviator and gains no plastic strain."""
+    """Any law (`LawStrength`): elastic while the trial lies inside the law's floor (from the cell's cached
+    hardening `hard` and G), else the trial returned onto the law's flow stress at the cell's plastic
+    strain, equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, with the
+    cell's shear modulus G (Mbar); `hard` follows the plastic strain (`law_hardening`), the Johnson-Cook
+    floors pass through. A cell with G = 0 (molten) carries no deviator and gains no plastic strain."""
     if G <= 0.0:
         return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    Y = law_flow_stress(strength.law, eps_p, equivalent_strain_rate(strain_rate), T_cell, P, eta)
-    s_new, d_eps = radial_return(s_trial, Y, G)
-    return s_new, d_eps, eps_p + d_eps, hard, flow_floor, floor_hotter, floor_T
+    rate = equivalent_strain_rate(strain_rate)
+    if 1.5 * abs(s_trial) <= LAW_FLOOR_SLACK * law_flow_stress_floor(strength.law, hard, G, rate, T_cell, eta):
+        return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    s_new, d_eps = radial_return(s_trial, law_flow_stress_at(strength.law, G, eps_p, rate, T_cell, P, eta), G)
+    if d_eps > 0.0:
+        eps_p += d_eps
+        hard = law_hardening(strength.law, eps_p)
+    return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, floor_T
 
 
 def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
@@ -123,7 +133,7 @@ def cell_shear_modulus(strength, P, T, eta):
 
 
 def initial_hardening(strength):
-    """Johnson-Cook's A + B 0^n (Mbar), the cells' initial `hard`; 0 for `LawStrength` (unused)."""
+    """The cells' initial `hard`: Johnson-Cook's A + B 0^n (Mbar), or the law's hardening at eps_p = 0."""
 
 
 def _is_johnson_cook(strength):
@@ -147,4 +157,4 @@ def _cell_shear_modulus(strength, P, T, eta):
 def _initial_hardening(strength):
     if _is_johnson_cook(strength):
         return lambda strength: hardening(strength.A, strength.B, strength.n, 0.0)
-    return lambda strength: 0.0
+    return lambda strength: law_hardening(strength.law, 0.0)

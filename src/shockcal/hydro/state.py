@@ -99,8 +99,9 @@ class Cells(NamedTuple):
     evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
     is one valid up to `plastic_return.FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
     so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
-    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. `hard` and
-    the floors are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused."""
+    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. The floors
+    are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused and `hard` holds the law's
+    hardening, from which its floor is read (`plastic_return.law_return`)."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
@@ -109,7 +110,7 @@ class Cells(NamedTuple):
     s: np.ndarray          # deviator s_xx, Mbar
     sigma: np.ndarray      # total stress -(P + q) + s, Mbar
     eps_p: np.ndarray      # equivalent plastic strain
-    hard: np.ndarray       # A + B eps_p^n, Mbar
+    hard: np.ndarray       # A + B eps_p^n (Mbar), or the law's cached hardening (laws.kernels.law_hardening)
     flow_floor: np.ndarray  # Mbar
     floor_hotter: np.ndarray  # Mbar
     floor_T: np.ndarray    # K

@@ -12,14 +12,28 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
-from shockcal.hydro.laws.preston_tonks_wallace import PrestonTonksWallace, ptw_flow_stress, ptw_shear_modulus
+from shockcal.hydro.laws.preston_tonks_wallace import (
+    PrestonTonksWallace,
+    ptw_flow_stress,
+    ptw_flow_stress_at,
+    ptw_flow_stress_floor,
+    ptw_hardening,
+    ptw_shear_modulus,
+)
 from shockcal.hydro.laws.steinberg_guinan import (
     SteinbergGuinan,
     steinberg_guinan_flow_stress,
+    steinberg_guinan_flow_stress_at,
+    steinberg_guinan_flow_stress_floor,
+    steinberg_guinan_hardening,
     steinberg_guinan_melt_temperature,
     steinberg_guinan_shear_modulus,
 )
-from shockcal.hydro.laws.zerilli_armstrong import ZerilliArmstrong, zerilli_armstrong_flow_stress
+from shockcal.hydro.laws.zerilli_armstrong import (
+    ZerilliArmstrong,
+    zerilli_armstrong_flow_stress,
+    zerilli_armstrong_flow_stress_floor,
+)
 from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 
 GPA_TO_MBAR = 1.0 / MBAR_TO_GPA
@@ -60,7 +74,10 @@ class Law:
     """A strength law: its kernels (code units, `flow_stress(law, eps_p, rate, T, P, eta)`; the
     optional `shear_modulus(law, P, T, eta)`), its parameters and the constraints on their values
     (text, predicate on the user values); `melt_temperature(law, eta)` (K), where the strength vanishes, for
-    the laws that have one."""
+    the laws that have one. Optional kernels that spare the solver work (`shockcal.hydro.laws.kernels`):
+    `flow_stress_at(law, G, eps_p, rate, T, P, eta)` for a law with a modulus law (the flow stress with
+    the cell's G, not recomputed), and `flow_stress_floor(law, hard, G, rate, T, eta)`, a proven lower
+    bound of the flow stress from `hardening(law, eps_p)`, which the solver caches per cell."""
 
     name: str
     title: str
@@ -71,6 +88,9 @@ class Law:
     shear_modulus: Callable | None = None
     constraints: tuple[tuple[str, Callable[[Mapping[str, float]], bool]], ...] = ()
     melt_temperature: Callable | None = None
+    flow_stress_at: Callable | None = None
+    hardening: Callable | None = None
+    flow_stress_floor: Callable | None = None
 
     def param(self, name: str) -> Param:
         return next(p for p in self.params if p.name == name)
@@ -119,6 +139,8 @@ STEINBERG_GUINAN = Law(
                  ("Ymax_GPa >= Y0_GPa", lambda v: v["Ymax_GPa"] >= v["Y0_GPa"]),
                  ("beta >= 0 and eps_i >= 0", lambda v: v["beta"] >= 0 and v["eps_i"] >= 0)),
     melt_temperature=steinberg_guinan_melt_temperature,
+    flow_stress_at=steinberg_guinan_flow_stress_at, hardening=steinberg_guinan_hardening,
+    flow_stress_floor=steinberg_guinan_flow_stress_floor,
 )
 
 PRESTON_TONKS_WALLACE = Law(
@@ -151,6 +173,7 @@ PRESTON_TONKS_WALLACE = Law(
          lambda v: min(v["gamma"], v["G0_GPa"], v["M_g_per_mol"], v["rho0_g_per_cc"]) > 0 and v["p"] >= 0),
     ),
     melt_temperature=lambda law, eta: law.T_melt,
+    flow_stress_at=ptw_flow_stress_at, hardening=ptw_hardening, flow_stress_floor=ptw_flow_stress_floor,
 )
 
 ZERILLI_ARMSTRONG = Law(
@@ -165,6 +188,7 @@ ZERILLI_ARMSTRONG = Law(
     ),
     ZerilliArmstrong, zerilli_armstrong_flow_stress,
     constraints=(("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0),),
+    flow_stress_floor=zerilli_armstrong_flow_stress_floor,
 )
 
 LAWS: dict[str, Law] = {law.name: law for law in (JOHNSON_COOK, STEINBERG_GUINAN, PRESTON_TONKS_WALLACE,

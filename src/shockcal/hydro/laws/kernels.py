@@ -4,6 +4,14 @@ compiles (no run-time branch, no function objects passed around, so callers stay
     law_flow_stress(law, eps_p, strain_rate, T, P, eta) -> Mbar
     law_shear_modulus(law, G, P, T, eta) -> Mbar   (the law's G(P, T, eta), or the constant G for laws
                                                       without one: Johnson-Cook, Zerilli-Armstrong)
+    law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta) -> Mbar   (with the cell's G from
+                                                      law_shear_modulus, which the law does not recompute)
+    law_hardening(law, eps_p) -> the law's cached hardening (0 for laws without one)
+    law_flow_stress_floor(law, hard, G, strain_rate, T, eta) -> Mbar   (a lower bound of the flow stress
+                                                      from the cached hardening, -1 where the law has none)
+
+The solver skips the full flow stress of a cell whose elastic trial lies inside the floor
+(`shockcal.hydro.plastic_return.law_return`); `hard` is recomputed only when the plastic strain changes.
 
 Arguments and units as in `shockcal.hydro.laws` (strain rate the equivalent one, 1/us; T in K; P in
 Mbar; eta = rho / rho0). The pure-Python bodies below serve outside numba (tests, notebooks).
@@ -48,3 +56,49 @@ def _law_shear_modulus(law, G, P, T, eta):
     if modulus is None:
         return lambda law, G, P, T, eta: G
     return lambda law, G, P, T, eta: modulus(law, P, T, eta)
+
+
+def law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
+    """Flow stress (Mbar) where the law's shear modulus is G (Mbar); laws without a modulus law ignore G."""
+    kernel = _law_of(type(law)).flow_stress_at
+    if kernel is None:
+        return law_flow_stress(law, eps_p, strain_rate, T, P, eta)
+    return kernel(law, G, eps_p, strain_rate, T, P, eta)
+
+
+def law_hardening(law, eps_p):
+    """The law's hardening at `eps_p` that its floor reads (0.0 for a law without one)."""
+    kernel = _law_of(type(law)).hardening
+    return 0.0 if kernel is None else kernel(law, eps_p)
+
+
+def law_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+    """A lower bound (Mbar) of the law's flow stress at the cell's plastic strain (through `hard`), shear
+    modulus G (Mbar), equivalent strain rate (1/us), temperature (K) and eta; -1.0 when it has none."""
+    kernel = _law_of(type(law)).flow_stress_floor
+    return -1.0 if kernel is None else kernel(law, hard, G, strain_rate, T, eta)
+
+
+@overload(law_flow_stress_at, jit_options={"cache": True})
+def _law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
+    kernel = _law_of(law).flow_stress_at
+    if kernel is None:
+        flow = _law_of(law).flow_stress
+        return lambda law, G, eps_p, strain_rate, T, P, eta: flow(law, eps_p, strain_rate, T, P, eta)
+    return lambda law, G, eps_p, strain_rate, T, P, eta: kernel(law, G, eps_p, strain_rate, T, P, eta)
+
+
+@overload(law_hardening, jit_options={"cache": True})
+def _law_hardening(law, eps_p):
+    kernel = _law_of(law).hardening
+    if kernel is None:
+        return lambda law, eps_p: 0.0
+    return lambda law, eps_p: kernel(law, eps_p)
+
+
+@overload(law_flow_stress_floor, jit_options={"cache": True})
+def _law_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+    kernel = _law_of(law).flow_stress_floor
+    if kernel is None:
+        return lambda law, hard, G, strain_rate, T, eta: -1.0
+    return lambda law, hard, G, strain_rate, T, eta: kernel(law, hard, G, strain_rate, T, eta)

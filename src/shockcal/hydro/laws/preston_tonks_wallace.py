@@ -73,13 +73,34 @@ def ptw_vibration_rate(law, G, eta):
 
 
 @njit(cache=True, error_model="numpy")
-def ptw_flow_stress(law, eps_p, strain_rate, T, P, eta):
+def ptw_rate_ratio(law, G, strain_rate, eta):
+    """r = epsdot / (gamma xi_dot) at equivalent strain rate `strain_rate` (1/us), shear modulus G (Mbar)."""
+    return strain_rate / (law.gamma * ptw_vibration_rate(law, G, eta))
+
+
+@njit(cache=True, error_model="numpy")
+def ptw_hardened(law, tau_s, tau_y, eps_p):
+    """tau^ at equivalent plastic strain `eps_p` between the yield `tau_y` and saturation `tau_s` stresses
+    (over G): eq. (6), tau_s when tau_y >= tau_s."""
+    spread = tau_s - tau_y
+    if spread <= 0.0:
+        return tau_s
+    if law.p == 0.0:
+        return tau_s - spread * math.exp(-law.theta * eps_p / spread)
+    scale = law.s0 - tau_y
+    x = law.p * spread / scale
+    return tau_s + scale / law.p * math.log1p(
+        math.expm1(-x) * math.exp(-law.p * law.theta * eps_p / (scale * math.expm1(x))))
+
+
+@njit(cache=True, error_model="numpy")
+def ptw_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
     """Flow stress (Mbar) at equivalent plastic strain `eps_p`, equivalent strain rate `strain_rate`
-    (1/us), temperature `T` (K) and density ratio `eta` (through rho in xi_dot); `P` not used."""
-    G = ptw_shear_modulus(law, P, T, eta)
+    (1/us), temperature `T` (K) and density ratio `eta`, where the shear modulus is `G` (Mbar, the law's
+    G(T)); `P` not used."""
     if G <= 0.0:
         return 0.0
-    r = strain_rate / (law.gamma * ptw_vibration_rate(law, G, eta))
+    r = ptw_rate_ratio(law, G, strain_rate, eta)
     T_hat = T / law.T_melt
     if T_hat <= 0.0:
         thermal = 0.0
@@ -90,14 +111,36 @@ def ptw_flow_stress(law, eps_p, strain_rate, T, P, eta):
     power_s = law.s0 * r ** law.beta
     tau_s = max(law.s0 - (law.s0 - law.sinf) * thermal, power_s)
     tau_y = max(law.y0 - (law.y0 - law.yinf) * thermal, min(law.y1 * r ** law.y2, power_s))
-    spread = tau_s - tau_y
-    if spread <= 0.0:
-        tau = tau_s
-    elif law.p == 0.0:
-        tau = tau_s - spread * math.exp(-law.theta * eps_p / spread)
-    else:
-        scale = law.s0 - tau_y
-        x = law.p * spread / scale
-        tau = tau_s + scale / law.p * math.log1p(
-            math.expm1(-x) * math.exp(-law.p * law.theta * eps_p / (scale * math.expm1(x))))
-    return 2.0 * G * tau
+    return 2.0 * G * ptw_hardened(law, tau_s, tau_y, eps_p)
+
+
+@njit(cache=True, error_model="numpy")
+def ptw_flow_stress(law, eps_p, strain_rate, T, P, eta):
+    """Flow stress (Mbar) at equivalent plastic strain `eps_p`, equivalent strain rate `strain_rate`
+    (1/us), temperature `T` (K) and density ratio `eta` (through rho in xi_dot); `P` not used."""
+    return ptw_flow_stress_at(law, ptw_shear_modulus(law, P, T, eta), eps_p, strain_rate, T, P, eta)
+
+
+@njit(cache=True, error_model="numpy")
+def ptw_hardening(law, eps_p):
+    """tau^ (over G) at `eps_p` in the quasi-static limit (r = 0: tau_s = sinf, tau_y = yinf)."""
+    return ptw_hardened(law, law.sinf, law.yinf, eps_p)
+
+
+@njit(cache=True, error_model="numpy")
+def ptw_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+    """2 G `hard` (Mbar), the quasi-static flow stress at the cell's plastic strain (`hard` =
+    `ptw_hardening`), a lower bound of the flow stress while r <= 1; -1 (none) for r > 1.
+
+    Why it bounds: at any r > 0, thermal <= 1 = its value at r = 0, so tau_s >= sinf and tau_y >= yinf
+    (s0 > sinf, y0 > yinf; the power branches only raise them). Eq. (6) is the solution at psi of
+    dtau/dpsi = theta (exp(k (tau_s - tau)) - 1) / (exp(k (tau_s - tau_y)) - 1), tau(0) = tau_y,
+    k = p / (s0 - tau_y). It does not fall as tau_s rises: its derivative in tau_s is
+    1 - exp(-w) (exp(-x) + w) / (1 - (1 - exp(-x)) exp(-w)) >= 0, since w exp(-w) <= 1 - exp(-w)
+    (x = k (tau_s - tau_y), w = k theta psi / (exp(x) - 1)). Nor as tau_y rises while tau_s <= s0: the
+    start rises, and the right-hand side grows with k while k (tau_s - tau_y) falls. For r <= 1,
+    tau_s <= s0 and tau_y <= s0, so raising tau_y from yinf at tau_s = sinf, then tau_s, keeps to
+    where both hold; tau_y >= tau_s gives tau_s, above every value below it."""
+    if ptw_rate_ratio(law, G, strain_rate, eta) > 1.0:
+        return -1.0
+    return 2.0 * G * hard

@@ -52,8 +52,28 @@ def steinberg_guinan_shear_modulus(law, P, T, eta):
 
 
 @njit(cache=True, error_model="numpy")
+def steinberg_guinan_hardening(law, eps_p):
+    """min(Y0 [1 + beta (eps_p + eps_i)]^n, Ymax) (Mbar): the yield stress at G = G0."""
+    return min(law.Y0 * (1.0 + law.beta * (eps_p + law.eps_i)) ** law.n, law.Ymax)
+
+
+@njit(cache=True, error_model="numpy")
+def steinberg_guinan_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
+    """Flow stress (Mbar) at equivalent plastic strain `eps_p` where the shear modulus is `G` (Mbar, the
+    law's G(P, T, eta)); `strain_rate`, `T`, `P` and `eta` enter only through G."""
+    return steinberg_guinan_hardening(law, eps_p) * G / law.G0
+
+
+@njit(cache=True, error_model="numpy")
 def steinberg_guinan_flow_stress(law, eps_p, strain_rate, T, P, eta):
     """Flow stress (Mbar) at equivalent plastic strain `eps_p`, temperature `T` (K), pressure `P`
     (Mbar) and density ratio `eta`; `strain_rate` (1/us) is not used (rate-independent form)."""
-    work_hardened = law.Y0 * (1.0 + law.beta * (eps_p + law.eps_i)) ** law.n
-    return min(work_hardened, law.Ymax) * steinberg_guinan_shear_modulus(law, P, T, eta) / law.G0
+    return steinberg_guinan_flow_stress_at(law, steinberg_guinan_shear_modulus(law, P, T, eta), eps_p, strain_rate,
+                                           T, P, eta)
+
+
+@njit(cache=True, error_model="numpy")
+def steinberg_guinan_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+    """The flow stress itself (Mbar) from the cell's cached `steinberg_guinan_hardening` and its G (Mbar):
+    the law has no rate term, so its floor is exact."""
+    return hard * G / law.G0

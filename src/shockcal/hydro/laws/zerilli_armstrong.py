@@ -37,3 +37,10 @@ def zerilli_armstrong_flow_stress(law, eps_p, strain_rate, T, P, eta):
     else:
         exponent = -law.C3 * T
     return law.C0 + law.C2 * math.sqrt(eps_p) * math.exp(exponent)
+
+
+@njit(cache=True, error_model="numpy")
+def zerilli_armstrong_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+    """C0 (Mbar), a lower bound of the flow stress at any strain, rate and temperature when C2 >= 0
+    (the exponential is positive); -1 (none) otherwise. `hard` and `G` are not used."""
+    return law.C0 if law.C2 >= 0.0 else -1.0
