@@ -27,8 +27,8 @@ from shockcal.cli import main
 from shockcal.errors import InputError
 from shockcal.hydro.laws import LAWS, code_parameters, flow_stress_curve, get_law, shear_modulus_gpa
 from shockcal.hydro.laws.boxes import load_boxes
-from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
 from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
+from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
 from shockcal.hydro.laws.steinberg_guinan import steinberg_guinan_melt_temperature, steinberg_guinan_shear_modulus
 from shockcal.hydro.plastic_return import LAW_FLOOR_SLACK, homologous_temperature
 from shockcal.hydro.state import Material
