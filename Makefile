@@ -55,22 +55,27 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
 # posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files
 # in order, the paper's config/config.yaml first (compare-models and model-predictions read the shots and records from it)
+# The laws' studies run side by side, MODEL_JOBS at a time (default all), each snakemake with --cores $(CORES): one
+# law's single-job steps (its calibrations) overlap the others' hydrocode runs, so the cores stay busy. Each line
+# of a study's console starts with its law. MODEL_JOBS=1 runs them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml
 MODELS_DIR ?= results/models
+MODEL_JOBS ?= $(words $(MODELS))
 
 models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
-	for model in $(MODELS); do \
-	  $(call snakemake,$(MODELS_DIR)/$$model) --cores $(CORES) --configfile $(MODELS_CONFIG) --config "strength={model: $$model}" \
-	    "study={results_dir: $(MODELS_DIR)/$$model}" -- $(MODELS_DIR)/$$model/posterior/joint.nc \
-	    $(MODELS_DIR)/$$model/report/emulator_heldout.csv || exit 1; \
-	done
+	$(MAKE) --no-print-directory -j $(MODEL_JOBS) $(addprefix model-study-,$(MODELS))
 	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
 	  --figures-dir $(MODELS_DIR)/figures
 	shockcal model-predictions --config $(firstword $(MODELS_CONFIG)) $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) \
 	  --out $(MODELS_DIR)/release.csv --figures-dir $(MODELS_DIR)/figures
 	@echo "results: $(CURDIR)/$(MODELS_DIR)/ (one study per law: $(MODELS))"
 	@echo "tables:  $(CURDIR)/$(MODELS_DIR)/evidence.csv and release.csv; figures: $(CURDIR)/$(MODELS_DIR)/figures/"
+
+model-study-%: $(INSTALLED)
+	set -o pipefail; $(call snakemake,$(MODELS_DIR)/$*) --cores $(CORES) --configfile $(MODELS_CONFIG) \
+	  --config "strength={model: $*}" "study={results_dir: $(MODELS_DIR)/$*}" -- $(MODELS_DIR)/$*/posterior/joint.nc \
+	  $(MODELS_DIR)/$*/report/emulator_heldout.csv 2>&1 | sed -u 's/^/[$*] /'
 
 models-reduced: $(INSTALLED)  ## the same at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)

@@ -27,9 +27,18 @@ def make_dry_run(target: str, **variables) -> str:
 
 
 def law_command(printed: str, law: str) -> list[str]:
-    """The snakemake call of the Makefile's per-law loop, for `law`."""
-    loop = re.search(r"for model in .*?; do(.*?)\|\| exit 1", printed.replace("\\\n", " "), flags=re.S).group(1)
-    return shlex.split(loop.replace("$model", law))
+    """The snakemake call of the Makefile's per-law target (model-study-<law>), without its console prefix."""
+    line = next(line for line in printed.replace("\\\n", " ").splitlines() if f"strength={{model: {law}}}" in line)
+    return shlex.split(line.removeprefix("set -o pipefail; ").split(" 2>&1 |")[0])
+
+
+def test_models_run_the_laws_side_by_side(tmp_path):
+    """`make models` runs one make job per law (MODEL_JOBS at a time, default all), each line of its console
+    prefixed with the law, and `MODEL_JOBS=1` one law after another."""
+    printed = make_dry_run("models-quick", MODELS="johnson-cook ptw")
+    assert "-j 2 model-study-johnson-cook model-study-ptw" in printed
+    assert "sed -u 's/^/[ptw] /'" in printed
+    assert "-j 1 model-study-johnson-cook" in make_dry_run("models", MODELS="johnson-cook ptw", MODEL_JOBS=1)
 
 
 def test_models_reduced_runs_each_law_to_its_predictive_runs(tmp_path):

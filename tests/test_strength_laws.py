@@ -28,7 +28,13 @@ from shockcal.errors import InputError
 from shockcal.hydro.laws import LAWS, code_parameters, flow_stress_curve, get_law, shear_modulus_gpa
 from shockcal.hydro.laws.boxes import load_boxes
 from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
-from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
+from shockcal.hydro.laws.kernels import (
+    law_flow_stress_at,
+    law_flow_stress_floor,
+    law_hardening,
+    law_remember_floor,
+    law_shear_modulus,
+)
 from shockcal.hydro.laws.steinberg_guinan import steinberg_guinan_melt_temperature, steinberg_guinan_shear_modulus
 from shockcal.hydro.plastic_return import LAW_FLOOR_SLACK, homologous_temperature
 from shockcal.hydro.state import Material
@@ -344,31 +350,66 @@ def _box_draws(name: str, count: int, rng) -> list[dict]:
     return sets
 
 
+def _random_state(rng) -> tuple[float, float, float, float, float]:
+    """(eps_p, equivalent strain rate 1/us, T K, P Mbar, eta): rates from 0 to 1e9 /s (PTW's r far above 1,
+    its overdriven branches), temperatures to the melt, compressions and tensions."""
+    eps_p = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 0)
+    rate = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 9) * PER_S_TO_PER_US
+    return eps_p, rate, rng.uniform(1.0, 1000.0), rng.uniform(-0.01, 0.15), rng.uniform(0.85, 1.4)
+
+
+NO_MEMORY = (0.0, 0.0, math.inf)         # a cell's floor slots before any evaluation (solver.initial_mesh)
+
+
 @pytest.mark.parametrize("name", ["steinberg-guinan", "ptw", "zerilli-armstrong"])
 def test_law_floor_lies_below_the_flow_stress(name):
     """The solver skips a law's flow stress while the elastic trial lies inside its floor
     (`law_flow_stress_floor`, from the cached `law_hardening`): exact only if the floor never exceeds
-    the flow stress. Checked over 40 parameter sets drawn from the prior box and 400 states each, with
-    strain rates from 0 to 1e9 /s (PTW's r far above 1, its overdriven branches), temperatures to the
-    melt, compressions and tensions; and the flow stress with the cell's G (`law_flow_stress_at`)
-    equals the law's own bit for bit."""
+    the flow stress. Checked over 40 parameter sets drawn from the prior box and 400 random states each;
+    and the flow stress with the cell's G (`law_flow_stress_at`) equals the law's own bit for bit."""
     law = get_law(name)
     rng = np.random.default_rng(20261128)
     hits = 0
     for _, code in _box_draws(name, 40, rng):
         for _ in range(400):
-            eps_p = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 0)
-            rate = 0.0 if rng.uniform() < 0.1 else 10 ** rng.uniform(-6, 9) * PER_S_TO_PER_US
-            T, P, eta = rng.uniform(1.0, 1000.0), rng.uniform(-0.01, 0.15), rng.uniform(0.85, 1.4)
+            eps_p, rate, T, P, eta = _random_state(rng)
             G = law_shear_modulus(code, 0.27, P, T, eta)
             if G <= 0.0:
                 continue
             Y = law.flow_stress(code, eps_p, rate, T, P, eta)
             assert law_flow_stress_at(code, G, eps_p, rate, T, P, eta) == Y
-            floor = law_flow_stress_floor(code, law_hardening(code, eps_p), G, rate, T, eta)
+            floor = law_flow_stress_floor(code, law_hardening(code, eps_p), G, rate, T, eta, *NO_MEMORY)
             assert LAW_FLOOR_SLACK * floor <= Y, (code, eps_p, rate, T, P, eta, floor, Y)
             hits += floor > 0.5 * Y
     assert hits > 1000          # the floor is not vacuous: it reaches half the flow stress in many states
+
+
+def test_ptw_remembered_floor_lies_below_the_flow_stress():
+    """PTW's remembered floor, set at one state (`law_remember_floor`), read at a later one: more plastic
+    strain, a strain rate 1/30 to 30 times the first, 3 K colder to 3 K hotter, another compression. The
+    floor's own checks decide whether it holds; whatever they decide must lie below the flow stress, and
+    it must often be above the quasi-static floor (or it would buy nothing)."""
+    rng = np.random.default_rng(28)
+    raised = 0
+    for _, code in _box_draws("ptw", 40, rng):
+        for _ in range(400):
+            eps_p, rate, T, P, eta = _random_state(rng)
+            G = law_shear_modulus(code, 0.27, P, T, eta)
+            if G <= 0.0:
+                continue
+            memory = law_remember_floor(code, G, eps_p, rate, T, eta, *NO_MEMORY)
+            eps_p2 = eps_p + (0.0 if rng.uniform() < 0.5 else 10 ** rng.uniform(-6, -1))
+            rate2, T2 = rate * 30 ** rng.uniform(-1, 1), T + rng.uniform(-3.0, 3.0)
+            eta2 = eta * (1 + rng.uniform(-0.01, 0.01))
+            G2 = law_shear_modulus(code, 0.27, P, T2, eta2)
+            if G2 <= 0.0:
+                continue
+            hard = law_hardening(code, eps_p2)
+            floor = law_flow_stress_floor(code, hard, G2, rate2, T2, eta2, *memory)
+            Y = get_law("ptw").flow_stress(code, eps_p2, rate2, T2, P, eta2)
+            assert LAW_FLOOR_SLACK * floor <= Y, (code, eps_p2, rate2, T2, eta2, memory, floor, Y)
+            raised += floor > law_flow_stress_floor(code, hard, G2, rate2, T2, eta2, *NO_MEMORY)
+    assert raised > 1000
 
 
 # ---------------------------------------------------------------------------------------------- 4. declarations

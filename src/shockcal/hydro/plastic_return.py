@@ -4,9 +4,10 @@ Johnson-Cook (`Strength`) is evaluated only when the trial leaves the cell's flo
 `new_floors`, `inside_floor`): a lower bound of (A + B eps_p^n)(1 - T*^m), valid while the cell is no hotter
 than when the floor was set (`FLOOR_MARGIN_K` more for the hotter floor), so an elastic cell costs no pow or
 log. Any other law (`LawStrength`) is evaluated only when the trial leaves the law's floor
-(`law_flow_stress_floor`: Steinberg-Guinan's exact flow stress, PTW's quasi-static one while r <= 1,
-Zerilli-Armstrong's C0), read from the hardening the cell caches in `hard`. Both skips are exact: a
-skipped cell is one the full evaluation would have left elastic. `plastic_return`, `cell_shear_modulus` and
+(`law_flow_stress_floor`: Steinberg-Guinan's exact flow stress, PTW's quasi-static one or the one it
+remembered at its last elastic evaluation, Zerilli-Armstrong's C0), read from the hardening the cell caches
+in `hard` and the floor it remembers in the Johnson-Cook floor slots. Both skips are exact: a skipped
+cell is one the full evaluation would have left elastic. `plastic_return`, `cell_shear_modulus` and
 `initial_hardening` pick their branch when numba compiles, by the type of the strength tuple, and are inlined
 into the solver's `update_cells`.
 """
@@ -16,7 +17,13 @@ from __future__ import annotations
 from numba import njit
 from numba.extending import overload
 
-from shockcal.hydro.laws.kernels import law_flow_stress_at, law_flow_stress_floor, law_hardening, law_shear_modulus
+from shockcal.hydro.laws.kernels import (
+    law_flow_stress_at,
+    law_flow_stress_floor,
+    law_hardening,
+    law_remember_floor,
+    law_shear_modulus,
+)
 from shockcal.hydro.state import Strength
 from shockcal.hydro.strength import (
     equivalent_strain_rate,
@@ -102,19 +109,24 @@ def johnson_cook_floored_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, 
 def law_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
                material):
     """Any law (`LawStrength`): elastic while the trial lies inside the law's floor (from the cell's cached
-    hardening `hard` and G), else the trial returned onto the law's flow stress at the cell's plastic
-    strain, equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density ratio, with the
-    cell's shear modulus G (Mbar); `hard` follows the plastic strain (`law_hardening`), the Johnson-Cook
-    floors pass through. A cell with G = 0 (molten) carries no deviator and gains no plastic strain."""
+    hardening `hard`, its remembered floor in the flow_floor, floor_hotter and floor_T slots, and G), else
+    the trial returned onto the law's flow stress at the cell's plastic strain, equivalent strain rate
+    (1/us), temperature (K), pressure (Mbar) and density ratio, with the cell's shear modulus G (Mbar).
+    `hard` follows the plastic strain (`law_hardening`); an elastic full evaluation sets the remembered
+    floor (`law_remember_floor`). A cell with G = 0 (molten) carries no deviator and gains no plastic strain."""
     if G <= 0.0:
         return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    rate = equivalent_strain_rate(strain_rate)
-    if 1.5 * abs(s_trial) <= LAW_FLOOR_SLACK * law_flow_stress_floor(strength.law, hard, G, rate, T_cell, eta):
+    law, rate = strength.law, equivalent_strain_rate(strain_rate)
+    floor = law_flow_stress_floor(law, hard, G, rate, T_cell, eta, flow_floor, floor_hotter, floor_T)
+    if 1.5 * abs(s_trial) <= LAW_FLOOR_SLACK * floor:
         return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    s_new, d_eps = radial_return(s_trial, law_flow_stress_at(strength.law, G, eps_p, rate, T_cell, P, eta), G)
+    s_new, d_eps = radial_return(s_trial, law_flow_stress_at(law, G, eps_p, rate, T_cell, P, eta), G)
     if d_eps > 0.0:
         eps_p += d_eps
-        hard = law_hardening(strength.law, eps_p)
+        hard = law_hardening(law, eps_p)
+    else:
+        flow_floor, floor_hotter, floor_T = law_remember_floor(law, G, eps_p, rate, T_cell, eta, flow_floor,
+                                                               floor_hotter, floor_T)
     return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, floor_T
 
 

@@ -100,8 +100,9 @@ class Cells(NamedTuple):
     is one valid up to `plastic_return.FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
     so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
     a pow or log; inside the floor times the rate factor (one log), elastic without a pow. The floors
-    are Johnson-Cook's (`Strength`); under `LawStrength` they stay unused and `hard` holds the law's
-    hardening, from which its floor is read (`plastic_return.law_return`)."""
+    are Johnson-Cook's (`Strength`); under `LawStrength` `hard` holds the law's hardening and the three
+    floor slots the floor a law remembers, in the law's meaning (`plastic_return.law_return`; PTW: tau^,
+    the lowest rate ratio and the highest temperature it holds for)."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm

@@ -18,6 +18,7 @@ from shockcal.hydro.laws.preston_tonks_wallace import (
     ptw_flow_stress_at,
     ptw_flow_stress_floor,
     ptw_hardening,
+    ptw_remember_floor,
     ptw_shear_modulus,
 )
 from shockcal.hydro.laws.steinberg_guinan import (
@@ -76,8 +77,10 @@ class Law:
     (text, predicate on the user values); `melt_temperature(law, eta)` (K), where the strength vanishes, for
     the laws that have one. Optional kernels that spare the solver work (`shockcal.hydro.laws.kernels`):
     `flow_stress_at(law, G, eps_p, rate, T, P, eta)` for a law with a modulus law (the flow stress with
-    the cell's G, not recomputed), and `flow_stress_floor(law, hard, G, rate, T, eta)`, a proven lower
-    bound of the flow stress from `hardening(law, eps_p)`, which the solver caches per cell."""
+    the cell's G, not recomputed), `flow_stress_floor(law, hard, G, rate, T, eta, flow_floor, floor_hotter,
+    floor_T)`, a proven lower bound of the flow stress from `hardening(law, eps_p)`, which the solver caches
+    per cell, and from the floor `remember_floor(law, G, eps_p, rate, T, eta, ...)` sets after a full
+    evaluation found the cell elastic."""
 
     name: str
     title: str
@@ -91,6 +94,7 @@ class Law:
     flow_stress_at: Callable | None = None
     hardening: Callable | None = None
     flow_stress_floor: Callable | None = None
+    remember_floor: Callable | None = None
 
     def param(self, name: str) -> Param:
         return next(p for p in self.params if p.name == name)
@@ -174,6 +178,7 @@ PRESTON_TONKS_WALLACE = Law(
     ),
     melt_temperature=lambda law, eta: law.T_melt,
     flow_stress_at=ptw_flow_stress_at, hardening=ptw_hardening, flow_stress_floor=ptw_flow_stress_floor,
+    remember_floor=ptw_remember_floor,
 )
 
 ZERILLI_ARMSTRONG = Law(

@@ -7,11 +7,16 @@ compiles (no run-time branch, no function objects passed around, so callers stay
     law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta) -> Mbar   (with the cell's G from
                                                       law_shear_modulus, which the law does not recompute)
     law_hardening(law, eps_p) -> the law's cached hardening (0 for laws without one)
-    law_flow_stress_floor(law, hard, G, strain_rate, T, eta) -> Mbar   (a lower bound of the flow stress
-                                                      from the cached hardening, -1 where the law has none)
+    law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T) -> Mbar
+        (a proven lower bound of the flow stress from the cell's cached hardening and remembered floor,
+         -1 where the law has none)
+    law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+        -> the cell's new remembered floor (flow_floor, floor_hotter, floor_T), the old one for laws
+           that remember none
 
 The solver skips the full flow stress of a cell whose elastic trial lies inside the floor
-(`shockcal.hydro.plastic_return.law_return`); `hard` is recomputed only when the plastic strain changes.
+(`shockcal.hydro.plastic_return.law_return`); `hard` is recomputed only when the plastic strain changes,
+the remembered floor only when a full evaluation finds the cell elastic.
 
 Arguments and units as in `shockcal.hydro.laws` (strain rate the equivalent one, 1/us; T in K; P in
 Mbar; eta = rho / rho0). The pure-Python bodies below serve outside numba (tests, notebooks).
@@ -72,11 +77,21 @@ def law_hardening(law, eps_p):
     return 0.0 if kernel is None else kernel(law, eps_p)
 
 
-def law_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+def law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
     """A lower bound (Mbar) of the law's flow stress at the cell's plastic strain (through `hard`), shear
-    modulus G (Mbar), equivalent strain rate (1/us), temperature (K) and eta; -1.0 when it has none."""
+    modulus G (Mbar), equivalent strain rate (1/us), temperature (K) and eta, from the cached hardening and
+    the remembered floor (flow_floor, floor_hotter, floor_T: their meaning is the law's); -1.0 when none."""
     kernel = _law_of(type(law)).flow_stress_floor
-    return -1.0 if kernel is None else kernel(law, hard, G, strain_rate, T, eta)
+    return -1.0 if kernel is None else kernel(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+
+
+def law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+    """The cell's remembered floor after a full evaluation found it elastic at this state; the given one
+    for a law that remembers none."""
+    kernel = _law_of(type(law)).remember_floor
+    if kernel is None:
+        return flow_floor, floor_hotter, floor_T
+    return kernel(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
 
 
 @overload(law_flow_stress_at, jit_options={"cache": True})
@@ -97,8 +112,19 @@ def _law_hardening(law, eps_p):
 
 
 @overload(law_flow_stress_floor, jit_options={"cache": True})
-def _law_flow_stress_floor(law, hard, G, strain_rate, T, eta):
+def _law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
     kernel = _law_of(law).flow_stress_floor
     if kernel is None:
-        return lambda law, hard, G, strain_rate, T, eta: -1.0
-    return lambda law, hard, G, strain_rate, T, eta: kernel(law, hard, G, strain_rate, T, eta)
+        return lambda law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: -1.0
+    return lambda law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: kernel(
+        law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+
+
+@overload(law_remember_floor, jit_options={"cache": True})
+def _law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+    kernel = _law_of(law).remember_floor
+    if kernel is None:
+        return lambda law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: (
+            flow_floor, floor_hotter, floor_T)
+    return lambda law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: kernel(
+        law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
