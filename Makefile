@@ -55,16 +55,19 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
 # posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files
 # in order, the paper's config/config.yaml first (compare-models and model-predictions read the shots and records from it)
-# The laws' studies run side by side, MODEL_JOBS at a time (default all), each snakemake with --cores $(CORES): one
-# law's single-job steps (its calibrations) overlap the others' hydrocode runs, so the cores stay busy. Each line
-# of a study's console starts with its law. MODEL_JOBS=1 runs them one after another.
+# The laws' studies run side by side, MODEL_JOBS at a time (default 2), each snakemake with --cores $(CORES), the
+# costliest first (MODEL_ORDER): one law's single-job steps (its calibrations) overlap another's hydrocode runs, so
+# the cores stay busy without crowding them. Each line of a study's console starts with its law. MODEL_JOBS=1 runs
+# them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml
 MODELS_DIR ?= results/models
-MODEL_JOBS ?= $(words $(MODELS))
+MODEL_JOBS ?= 2
+MODEL_ORDER := ptw steinberg-guinan johnson-cook zerilli-armstrong
 
 models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
-	$(MAKE) --no-print-directory -j $(MODEL_JOBS) $(addprefix model-study-,$(MODELS))
+	$(MAKE) --no-print-directory -j $(MODEL_JOBS) \
+	  $(addprefix model-study-,$(filter $(MODELS),$(MODEL_ORDER)) $(filter-out $(MODEL_ORDER),$(MODELS)))
 	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
 	  --figures-dir $(MODELS_DIR)/figures
 	shockcal model-predictions --config $(firstword $(MODELS_CONFIG)) $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) \

@@ -35,7 +35,11 @@ from shockcal.hydro.laws.kernels import (
     law_remember_floor,
     law_shear_modulus,
 )
-from shockcal.hydro.laws.steinberg_guinan import steinberg_guinan_melt_temperature, steinberg_guinan_shear_modulus
+from shockcal.hydro.laws.steinberg_guinan import (
+    steinberg_guinan_melt_temperature,
+    steinberg_guinan_melt_temperature_below,
+    steinberg_guinan_shear_modulus,
+)
 from shockcal.hydro.plastic_return import LAW_FLOOR_SLACK, homologous_temperature
 from shockcal.hydro.state import Material
 from shockcal.hydro.strength import equivalent_strain_rate, flow_stress, hardening, thermal_factor
@@ -338,11 +342,13 @@ def test_steinberg_guinan_against_impala(impala_functions):
 
 
 # ---------------------------------------------------------------------------------------------- 3b. solver floors
-def _box_draws(name: str, count: int, rng) -> list[dict]:
-    """Parameter sets drawn uniformly from the law's prior box (config/models.yaml), constraints met."""
+def _box_draws(name: str, count: int, rng, **ranges) -> list[tuple[dict, tuple]]:
+    """(user values, code tuple) drawn uniformly from the law's prior box (config/models.yaml) and any
+    further `ranges` (name=(low, high)), constraints met."""
     box, law, sets = load_boxes()[name], get_law(name), []
     while len(sets) < count:
         values = {k: rng.uniform(b.low, b.high) for k, b in box.items()}
+        values.update({k: rng.uniform(low, high) for k, (low, high) in ranges.items()})
         try:
             sets.append((values, code_parameters(law, values)))
         except InputError:
@@ -382,6 +388,19 @@ def test_law_floor_lies_below_the_flow_stress(name):
             assert LAW_FLOOR_SLACK * floor <= Y, (code, eps_p, rate, T, P, eta, floor, Y)
             hits += floor > 0.5 * Y
     assert hits > 1000          # the floor is not vacuous: it reaches half the flow stress in many states
+
+
+def test_steinberg_guinan_melt_bound_lies_below_the_melt_temperature():
+    """G(P, T, eta) evaluates the melt law only where T reaches its cheap lower bound: exact only if the bound
+    never exceeds T_melt(eta). 2000 sets (the box, gamma0 0.5-3, a 0-3, T_m0 500-2000 K) x 50 eta in
+    0.5-2; and the bound is close near eta = 1, where the shots' cells are."""
+    rng = np.random.default_rng(1)
+    ranges = dict(gamma0=(0.5, 3.0), a=(0.0, 3.0), T_m0_K=(500.0, 2000.0))
+    for values, code in _box_draws("steinberg-guinan", 2000, rng, **ranges):
+        for eta in rng.uniform(0.5, 2.0, 50):
+            assert steinberg_guinan_melt_temperature_below(code, eta) <= steinberg_guinan_melt_temperature(code, eta)
+        ratio = steinberg_guinan_melt_temperature_below(code, 1.02) / steinberg_guinan_melt_temperature(code, 1.02)
+        assert ratio > 0.99, values
 
 
 def test_ptw_remembered_floor_lies_below_the_flow_stress():

@@ -102,7 +102,7 @@ class Cells(NamedTuple):
     a pow or log; inside the floor times the rate factor (one log), elastic without a pow. The floors
     are Johnson-Cook's (`Strength`); under `LawStrength` `hard` holds the law's hardening and the three
     floor slots the floor a law remembers, in the law's meaning (`plastic_return.law_return`; PTW: tau^,
-    the lowest rate ratio and the highest temperature it holds for)."""
+    the sixth power of the lowest rate ratio and the highest temperature it holds for)."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm

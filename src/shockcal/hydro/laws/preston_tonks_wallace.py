@@ -79,6 +79,15 @@ def ptw_rate_ratio(law, G, strain_rate, eta):
 
 
 @njit(cache=True, error_model="numpy")
+def ptw_rate_ratio_sixth(law, G, strain_rate, eta):
+    """r^6 without a root: r = epsdot eta^(1/6) / (K sqrt(G)), K = gamma / 2 (4 pi rho0 N_A / (3 M))^(1/3) / sqrt(rho0),
+    so r^6 = epsdot^6 eta / (K^6 G^3), K^6 = gamma^6 / 64 (4 pi rho0 N_A / (3 M))^2 / rho0^3."""
+    k_sixth = law.gamma ** 6 / 64.0 * (4.0 * math.pi * law.rho0 * AVOGADRO / (3.0 * law.M)) ** 2 / law.rho0 ** 3
+    rate_cubed = strain_rate * strain_rate * strain_rate
+    return rate_cubed * rate_cubed * eta / (k_sixth * G * G * G)
+
+
+@njit(cache=True, error_model="numpy")
 def ptw_hardened(law, tau_s, tau_y, eps_p):
     """tau^ at equivalent plastic strain `eps_p` between the yield `tau_y` and saturation `tau_s` stresses
     (over G): eq. (6), tau_s when tau_y >= tau_s."""
@@ -140,7 +149,8 @@ def ptw_flow_stress(law, eps_p, strain_rate, T, P, eta):
 #    rises or as T falls, so tau^ at (r, T, eps_p) is at least its value at any (r_f <= r, T_f >= T,
 #    eps_p_f <= eps_p). After a full evaluation finds a cell elastic, it remembers tau^ at
 #    r_f = r PTW_FLOOR_RATE_FACTOR and T_f = T + PTW_FLOOR_MARGIN_K (the cell's flow_floor, floor_hotter
-#    and floor_T slots); the floor holds while r_f <= r <= 1 and T <= T_f (eps_p only grows).
+#    and floor_T slots: tau^, r_f^6, T_f); the floor holds while r_f <= r <= 1 and T <= T_f (eps_p only
+#    grows), checked on r^6, which needs no root (`ptw_rate_ratio_sixth`).
 PTW_FLOOR_RATE_FACTOR = math.exp(-0.5)   # measured best of e^-0.1 .. e^-3 on 105S posterior runs
 PTW_FLOOR_MARGIN_K = 1.0                 # measured best of 0.2 .. 10 K
 
@@ -161,25 +171,23 @@ def ptw_hardening(law, eps_p):
 @njit(cache=True, error_model="numpy")
 def ptw_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
     """A lower bound (Mbar) of the flow stress at shear modulus G (Mbar), equivalent strain rate (1/us),
-    temperature T (K) and eta: 2 G times the cell's remembered tau^ `flow_floor` while it holds (rate
-    ratio from `floor_hotter` to 1, T <= `floor_T`), else 2 G `hard`, the quasi-static tau^; -1 (none)
+    temperature T (K) and eta: 2 G times the cell's remembered tau^ `flow_floor` while it holds (r^6
+    from `floor_hotter` to 1, T <= `floor_T`), else 2 G `hard`, the quasi-static tau^; -1 (none)
     where the floors do not hold."""
     if hard < 0.0:
         return -1.0
-    if flow_floor > hard and T <= floor_T:
-        r = ptw_rate_ratio(law, G, strain_rate, eta)
-        if floor_hotter <= r <= 1.0:
-            return 2.0 * G * flow_floor
+    if flow_floor > hard and T <= floor_T and floor_hotter <= ptw_rate_ratio_sixth(law, G, strain_rate, eta) <= 1.0:
+        return 2.0 * G * flow_floor
     return 2.0 * G * hard
 
 
 @njit(cache=True, error_model="numpy")
 def ptw_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    """The cell's remembered floor after a full evaluation found it elastic: (tau^ at r_f and T_f, r_f,
+    """The cell's remembered floor after a full evaluation found it elastic: (tau^ at r_f and T_f, r_f^6,
     T_f) with r_f = r PTW_FLOOR_RATE_FACTOR, T_f = T + PTW_FLOOR_MARGIN_K; the old one kept where none
     can be set (r > 1, or the floors do not hold)."""
     r = ptw_rate_ratio(law, G, strain_rate, eta)
     if r > 1.0 or not ptw_floors_hold(law):
         return flow_floor, floor_hotter, floor_T
     r_floor, T_floor = r * PTW_FLOOR_RATE_FACTOR, T + PTW_FLOOR_MARGIN_K
-    return ptw_tau(law, r_floor, T_floor, eps_p), r_floor, T_floor
+    return ptw_tau(law, r_floor, T_floor, eps_p), r_floor ** 6, T_floor

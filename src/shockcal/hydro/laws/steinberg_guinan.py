@@ -43,9 +43,20 @@ def steinberg_guinan_melt_temperature(law, eta):
 
 
 @njit(cache=True, error_model="numpy")
+def steinberg_guinan_melt_temperature_below(law, eta):
+    """A lower bound (K) of T_melt(eta) without exp or pow: T_melt = T_m0 exp(E), E = 2 a (1 - 1/eta)
+    + c ln(eta), c = 2 (gamma0 - a - 1/3); ln(eta) lies between 1 - 1/eta and eta - 1, and exp(E) >= 1 + E.
+    Lowered by 1e-12 of itself, far above the rounding of either side."""
+    c = 2.0 * (law.gamma0 - law.a - 1.0 / 3.0)
+    log_eta_times_c = c * (1.0 - 1.0 / eta) if c >= 0.0 else c * (eta - 1.0)
+    return law.T_m0 * (1.0 + 2.0 * law.a * (1.0 - 1.0 / eta) + log_eta_times_c) * (1.0 - 1e-12)
+
+
+@njit(cache=True, error_model="numpy")
 def steinberg_guinan_shear_modulus(law, P, T, eta):
-    """G(P, T, eta) (Mbar) at pressure `P` (Mbar), temperature `T` (K) and density ratio `eta`."""
-    if T >= steinberg_guinan_melt_temperature(law, eta):
+    """G(P, T, eta) (Mbar) at pressure `P` (Mbar), temperature `T` (K) and density ratio `eta`; the melt
+    law is evaluated only where T reaches its cheap lower bound."""
+    if T >= steinberg_guinan_melt_temperature_below(law, eta) and T >= steinberg_guinan_melt_temperature(law, eta):
         return 0.0
     G = law.G0 * (1.0 + (law.dGdP / law.G0) * P * eta ** (-1.0 / 3.0) + law.dGdT_over_G0 * (T - SG_T_REF_K))
     return max(G, 0.0)
