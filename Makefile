@@ -55,14 +55,17 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # the strength laws compared by `make models` (docs/models.md): one study each, to its joint posterior and its
 # posterior predictive runs (the run set predict, through posterior/joint.nc); MODELS_CONFIG: the config files
 # in order, the paper's config/config.yaml first (compare-models and model-predictions read the shots and records from it)
-# The laws' studies run side by side, MODEL_JOBS at a time (default 2), each snakemake with --cores $(CORES), the
-# costliest first (MODEL_ORDER): one law's single-job steps (its calibrations) overlap another's hydrocode runs, so
-# the cores stay busy without crowding them. Each line of a study's console starts with its law. MODEL_JOBS=1 runs
-# them one after another.
+# The laws' studies run side by side, MODEL_JOBS at a time, each snakemake with --cores MODEL_CORES, the costliest
+# first (MODEL_ORDER). By default the machine's cores (CORES, or nproc's count for `all`) are split between up to
+# four laws: on 2 cores two laws at a time, one job each, so every core runs one job from start to end (no core
+# idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each. Each line of a
+# study's console starts with its law. MODEL_JOBS=1 runs them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml
 MODELS_DIR ?= results/models
-MODEL_JOBS ?= 2
+MACHINE_CORES := $(if $(filter all,$(CORES)),$(shell nproc),$(CORES))
+MODEL_JOBS ?= $(shell echo $$(( $(MACHINE_CORES) < 4 ? $(MACHINE_CORES) : 4 )))
+MODEL_CORES ?= $(shell echo $$(( $(MACHINE_CORES) / $(MODEL_JOBS) > 1 ? $(MACHINE_CORES) / $(MODEL_JOBS) : 1 )))
 MODEL_ORDER := ptw steinberg-guinan johnson-cook zerilli-armstrong
 
 models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
@@ -76,7 +79,7 @@ models: $(INSTALLED)  ## every law's study (strength.model) into results/models/
 	@echo "tables:  $(CURDIR)/$(MODELS_DIR)/evidence.csv and release.csv; figures: $(CURDIR)/$(MODELS_DIR)/figures/"
 
 model-study-%: $(INSTALLED)
-	set -o pipefail; $(call snakemake,$(MODELS_DIR)/$*) --cores $(CORES) --configfile $(MODELS_CONFIG) \
+	set -o pipefail; $(call snakemake,$(MODELS_DIR)/$*) --cores $(MODEL_CORES) --configfile $(MODELS_CONFIG) \
 	  --config "strength={model: $*}" "study={results_dir: $(MODELS_DIR)/$*}" -- $(MODELS_DIR)/$*/posterior/joint.nc \
 	  $(MODELS_DIR)/$*/report/emulator_heldout.csv 2>&1 | sed -u 's/^/[$*] /'
 

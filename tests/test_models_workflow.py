@@ -32,13 +32,23 @@ def law_command(printed: str, law: str) -> list[str]:
     return shlex.split(line.removeprefix("set -o pipefail; ").split(" 2>&1 |")[0])
 
 
+def cores_of(command: list[str]) -> str:
+    """The --cores a snakemake call is given."""
+    return command[command.index("--cores") + 1]
+
+
 def test_models_run_the_laws_side_by_side(tmp_path):
-    """`make models` runs one make job per law, MODEL_JOBS at a time (default 2), the costliest first, each line
-    of its console prefixed with the law; `MODEL_JOBS=1` one law after another."""
-    printed = make_dry_run("models-quick", MODELS="johnson-cook ptw zerilli-armstrong").replace("\\\n", " ")
+    """`make models` runs one make job per law, the costliest first, each line of its console prefixed with the
+    law. The machine's cores are split between up to four laws: on 2 cores two at a time with one core each, on
+    8 four with two each; `MODEL_JOBS=1` runs one law after another on every core."""
+    printed = make_dry_run("models-quick", MODELS="johnson-cook ptw zerilli-armstrong", CORES=2).replace("\\\n", " ")
     assert re.search(r"-j 2 +model-study-ptw model-study-johnson-cook model-study-zerilli-armstrong", printed)
     assert "sed -u 's/^/[ptw] /'" in printed
-    assert re.search(r"-j 1 \\\s+model-study-ptw", make_dry_run("models", MODELS="johnson-cook ptw", MODEL_JOBS=1))
+    assert {cores_of(law_command(printed, law)) for law in ("johnson-cook", "ptw", "zerilli-armstrong")} == {"1"}
+    printed = make_dry_run("models-quick", CORES=8)
+    assert re.search(r"-j 4 ", printed.replace("\\\n", " ")) and cores_of(law_command(printed, "ptw")) == "2"
+    one_by_one = make_dry_run("models", MODELS="johnson-cook ptw", MODEL_JOBS=1, CORES=2)
+    assert re.search(r"-j 1 \\\s+model-study-ptw", one_by_one) and cores_of(law_command(one_by_one, "ptw")) == "2"
 
 
 def test_models_reduced_runs_each_law_to_its_predictive_runs(tmp_path):
