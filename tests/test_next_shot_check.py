@@ -21,7 +21,7 @@ from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import AL5083
 from shockcal.study.adapters import candidate, candidate_box, input_box, shot_mapping, study_design
 from shockcal.study.config import input_names, prior_bounds
-from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config
+from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config, plan_check
 from shockcal.study.validate import validate_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -227,6 +227,32 @@ def test_the_candidates_are_the_rankings_best_and_worst_or_those_named(paper_con
     assert check_candidates(paper_config, ranking) == [HOT, REPEAT]
     paper_config["next_shot"]["check"]["candidates"] = ["105S-repeat", HOT]
     assert check_candidates(paper_config, tmp_path / "absent.csv") == ["105S-repeat", HOT]
+
+
+def test_a_sequential_study_plans_its_check_on_wave_0_and_is_never_refused_for_it(paper_config, tmp_path):
+    """In a study in waves the check's derived studies are Latin-hypercube ones on wave 0's design (the training
+    run set). A check whose settings do not fit the study (more training runs than wave 0 has) refuses the check
+    when it is asked for, in one line naming the key, and leaves the study alone otherwise: every run of a
+    sequential study after `make next-shot` planned the check and stopped on design.file against waves."""
+    paper_config["design"].update(strategy="waves", waves={**paper_config["design"]["waves"], "initial_runs": 150,
+                                                            "runs_per_wave": 75, "max_runs": 300})
+    validate_config(paper_config)
+    design_file = tmp_path / "training" / "design.parquet"
+    design_file.parent.mkdir()
+    study_design(paper_config)[0].to_parquet(design_file)
+    ranking = tmp_path / "ranking.csv"
+    pd.DataFrame({"candidate": [HOT, REPEAT], "eig_nats": [1.2, 0.17]}).to_csv(ranking, index=False)
+    paper_config["next_shot"]["check"]["n_training_runs"] = 150
+    plans = plan_check(paper_config, ranking, design_file, tmp_path / "check", required=True)
+    assert sorted(plans) == sorted([HOT, REPEAT])
+    for plan in plans.values():
+        assert plan["study"]["design"]["strategy"] == "lhs" and plan["study"]["design"]["file"] == str(design_file)
+        assert len(plan["table"]) == 150 and Path(plan["config"]).is_file()
+    paper_config["next_shot"]["check"]["n_training_runs"] = 300
+    assert plan_check(paper_config, ranking, design_file, tmp_path / "check2", required=False) == {}
+    with pytest.raises(ConfigError, match="^next_shot.check.n_training_runs: 300 is more than the training "
+                                          "design's 150 rows$"):
+        plan_check(paper_config, ranking, design_file, tmp_path / "check2", required=True)
 
 
 def test_summary_command_names_a_missing_ranking(tmp_path, capsys):

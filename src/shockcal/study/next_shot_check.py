@@ -53,7 +53,9 @@ def derived_study_config(config: dict, name: str, design_file: str | Path) -> di
             "shear_modulus_inputs": modulus, "analysis": spec["analysis"]}
     if spec["initial_temperature_K"] is not None:
         shot["initial_temperature_K"] = spec["initial_temperature_K"]
-    derived["design"] = {**config["design"], "file": str(design_file),
+    # its training design is the file (a sequential study's: wave 0, its Latin hypercube), so the derived study
+    # is a Latin-hypercube one whatever the study's strategy
+    derived["design"] = {**config["design"], "strategy": "lhs", "file": str(design_file),
                          "base_shots": config["design"]["base_shots"] or list(config["shots"])}
     derived["shots"][name] = shot
     derived["observed"] = {**config["observed"], "source": "synthetic"}
@@ -93,8 +95,21 @@ def plan_check(config: dict, ranking_path: str | Path, design_file: str | Path, 
     `config` (the derived config's path), `design` (its training design's path), `study` (the derived config),
     `table` (the training design, with the candidate's velocity and shear modulus in the columns its runs read
     as a next-shot candidate's, `Candidate.mapping`: they go through the run sets' rules as the ranking's do),
-    each file under `directory`/<candidate>/ written when its content changes. Candidates that cannot be told
-    (no ranking yet) give {} unless `required` (the check is asked for), when the InputError goes up."""
+    each file under `directory`/<candidate>/ written when its content changes. A check that cannot be planned
+    (no ranking yet, or next_shot.check's settings do not fit the study) gives {} unless `required` (the check
+    is asked for), when the error goes up: a study is never refused for a check it was not asked to run."""
+    try:
+        return derived_studies(config, check_candidates(config, ranking_path), design_file, directory)
+    except (InputError, ConfigError):
+        if required:
+            raise
+        return {}
+
+
+def derived_studies(config: dict, names: list[str], design_file: str | Path, directory: str | Path
+                    ) -> dict[str, dict]:
+    """`plan_check`'s plans of candidates `names`, their files written; a ConfigError when the training design
+    (`design_file`) has fewer rows than next_shot.check.n_training_runs."""
     from dataclasses import replace
 
     import yaml
@@ -104,12 +119,6 @@ def plan_check(config: dict, ranking_path: str | Path, design_file: str | Path, 
     from shockcal.study.adapters import candidate_box, input_box, shot_mapping, study_design
     from shockcal.study.workflow import write_if_changed
 
-    try:
-        names = check_candidates(config, ranking_path)
-    except InputError:
-        if required:
-            raise
-        return {}
     plans = {}
     for name in names:
         study = derived_study_config(config, name, design_file)
