@@ -14,6 +14,9 @@ on first use, so the command line starts without them.
 """
 
 from shockcal._lazy import lazy_exports
+from shockcal._numba_cache import use_kernel_keyed_cache
+
+use_kernel_keyed_cache()    # before any kernel module: numba's cache keyed on every kernel file (_numba_cache)
 
 __version__ = "0.1.0"
 
