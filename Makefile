@@ -27,7 +27,7 @@ define study
 endef
 
 .DEFAULT_GOAL := help
-.PHONY: help env study sequential quick flag-archive models models-reduced models-sequential models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: help env study paper quick flag-archive models models-paper models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 help:  ## these targets, one line each
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
@@ -40,11 +40,20 @@ $(INSTALLED): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet $(CONSTRAINTS) -e '.[test]'
 	touch $@
 
-study: $(INSTALLED)  ## the paper's study (config/config.yaml): every figure and the HTML report into results
-	$(call study,results,all)
+# The study that study, check, next-shot and next-shot-check run: STUDY=sequential (the default; runs in waves
+# placed where the joint posterior lives, config/sequential.yaml over config/config.yaml; docs/sequential.md)
+# into results/sequential, or STUDY=paper (the paper's 1000 Latin-hypercube runs per shot, config/config.yaml)
+# into results
+STUDY ?= sequential
+$(if $(filter sequential paper,$(STUDY)),,$(error STUDY=$(STUDY): sequential (the default) or paper))
+STUDY_DIR = $(if $(filter paper,$(STUDY)),results,results/sequential)
+STUDY_CONFIG = $(if $(filter paper,$(STUDY)),,--configfile config/sequential.yaml)
 
-sequential: $(INSTALLED)  ## the study in waves placed from the joint posterior (config/sequential.yaml; docs/sequential.md) into results/sequential
-	$(call study,results/sequential,all --configfile config/sequential.yaml)
+study: $(INSTALLED)  ## the default study, in waves (999 hydrocode runs; STUDY=paper: the paper's design): every figure and the HTML report into results/sequential
+	$(call study,$(STUDY_DIR),all $(STUDY_CONFIG))
+
+paper: $(INSTALLED)  ## the paper's study (config/config.yaml: 1000 Latin-hypercube runs per shot, 3,300 in all): every figure and the HTML report into results
+	$(MAKE) --no-print-directory study STUDY=paper
 
 quick: $(INSTALLED)  ## the toy-size study (config/quick.yaml) and its HTML report into results/quick
 	$(call study,results/quick,all --configfile config/quick.yaml)
@@ -61,14 +70,14 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each. Each line of a
 # study's console starts with its law. MODEL_JOBS=1 runs them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
-MODELS_CONFIG ?= config/config.yaml
+MODELS_CONFIG ?= config/config.yaml config/sequential.yaml
 MODELS_DIR ?= results/models
 MACHINE_CORES := $(if $(filter all,$(CORES)),$(shell nproc),$(CORES))
 MODEL_JOBS ?= $(shell echo $$(( $(MACHINE_CORES) < 4 ? $(MACHINE_CORES) : 4 )))
 MODEL_CORES ?= $(shell echo $$(( $(MACHINE_CORES) / $(MODEL_JOBS) > 1 ? $(MACHINE_CORES) / $(MODEL_JOBS) : 1 )))
 MODEL_ORDER := ptw steinberg-guinan johnson-cook zerilli-armstrong
 
-models: $(INSTALLED)  ## every law's study (strength.model) into results/models/<law>, then evidence.csv, release.csv and figures/
+models: $(INSTALLED)  ## every law's study in waves (strength.model; config/sequential.yaml) into results/models/<law>, then evidence.csv, release.csv and figures/
 	$(MAKE) --no-print-directory -j $(MODEL_JOBS) \
 	  $(addprefix model-study-,$(filter $(MODELS),$(MODEL_ORDER)) $(filter-out $(MODEL_ORDER),$(MODELS)))
 	shockcal compare-models $(foreach m,$(MODELS),--model $(m)=$(MODELS_DIR)/$(m)) --out $(MODELS_DIR)/evidence.csv \
@@ -83,28 +92,28 @@ model-study-%: $(INSTALLED)
 	  --config "strength={model: $*}" "study={results_dir: $(MODELS_DIR)/$*}" -- $(MODELS_DIR)/$*/posterior/joint.nc \
 	  $(MODELS_DIR)/$*/report/emulator_heldout.csv 2>&1 | sed -u 's/^/[$*] /'
 
-models-reduced: $(INSTALLED)  ## the same at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
-	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
+models-paper: $(INSTALLED)  ## the same on the paper's design (1000 training and 100 predictive runs per shot) into results/models-paper
+	$(MAKE) models MODELS_CONFIG=config/config.yaml MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-paper)
 
-models-sequential: $(INSTALLED)  ## the same with every law's runs in waves (config/sequential.yaml: 300 training and 33 predictive runs per shot) into results/models-sequential
-	$(MAKE) models MODELS_CONFIG="config/config.yaml config/sequential.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-sequential)
+models-reduced: $(INSTALLED)  ## the paper's design at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
+	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
 
 models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into results/models-quick
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/quick.yaml" MODELS_DIR=results/models-quick
 
-check: $(INSTALLED)  ## synthetic-truth coverage checks of the default study (calibration.check.trials per check)
-	$(call snakemake,results) --cores $(CORES) check
-	@echo "results: $(CURDIR)/results/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
-	@echo "report:  their table joins $(CURDIR)/results/report.html at the next make study"
+check: $(INSTALLED)  ## synthetic-truth coverage checks of the study (calibration.check.trials per check; STUDY=paper: the paper's)
+	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) check $(STUDY_CONFIG)
+	@echo "results: $(CURDIR)/$(STUDY_DIR)/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
+	@echo "report:  their table joins $(CURDIR)/$(STUDY_DIR)/report.html at the next make study"
 
-next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain
-	$(call snakemake,results) --cores $(CORES) next_shot
-	@echo "results: $(CURDIR)/results/next_shot/ranking.csv"
-	@echo "figure:  $(CURDIR)/results/figures/next_shot.png"
+next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain (STUDY=paper: on the paper's study)
+	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot $(STUDY_CONFIG)
+	@echo "results: $(CURDIR)/$(STUDY_DIR)/next_shot/ranking.csv"
+	@echo "figure:  $(CURDIR)/$(STUDY_DIR)/figures/next_shot.png"
 
 next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: its best and worst candidates on truths from the posterior
-	$(call snakemake,results) --cores $(CORES) next_shot_check
-	@echo "results: $(CURDIR)/results/next_shot/check_summary.csv (per trial: check.csv)"
+	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot_check $(STUDY_CONFIG)
+	@echo "results: $(CURDIR)/$(STUDY_DIR)/next_shot/check_summary.csv (per trial: check.csv)"
 
 test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
 	$(VENV)/bin/pytest

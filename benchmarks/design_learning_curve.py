@@ -2,10 +2,10 @@
 where the calibration uses the emulator (docs/sequential.md, "Learning curves").
 
 Reads two finished studies:
-- `--paper`: the paper design (1000 Latin-hypercube runs per shot, `make study`). Its predictive runs
+- `--paper`: the paper design (1000 Latin-hypercube runs per shot, `make paper`). Its predictive runs
   (the run set `predict`: draws from its own joint posterior, run through the hydrocode for every
   shot, never trained on) are the held-out runs, and its joint posterior is the reference.
-- `--sequential`: a study in waves (`make sequential`); its steps (waves 0..k refitted and
+- `--sequential`: a study in waves (`make study`); its steps (waves 0..k refitted and
   recalibrated, results/sequential/waves/step{k}) are its points, its last step the study itself.
 
 The Latin-hypercube points below 1000 runs per shot are the study's emulator refitted on the design's

@@ -3,7 +3,7 @@ smaller design would cost in accuracy, against what it saves in hydrocode time).
 
 Fits the study's emulator (config/config.yaml settings) on the first N runs of the study's training
 design for several N and predicts the synthetic-truth check runs (`results/check`: hydrocode runs at
-inputs drawn from the prior, never trained on; `make check` or the hydrocode check makes them).
+inputs drawn from the prior, never trained on; `make check STUDY=paper` or the hydrocode check makes them).
 Prints per N: the RMSE over the 12 calibration features (m/s), the mean z^2 of the predictive sd
 (1 when the sd is honest) and the share inside the central 90% band of the fitted error model, and
 the fit time. The first N rows of a Latin hypercube are not themselves a Latin hypercube: a design
@@ -47,7 +47,7 @@ def main() -> None:
     needed = [args.results / run_set / "features" / f"{s}.parquet" for run_set in ("training", "check") for s in shots]
     missing = [str(p) for p in needed if not p.is_file()]
     if missing:
-        raise SystemExit(f"missing {', '.join(missing)}: run `make study` and `make check` first")
+        raise SystemExit(f"missing {', '.join(missing)}: run `make paper` and `make check STUDY=paper` first")
     design = pd.read_parquet(args.results / "training" / "design.parquet")
     training = {s: pd.read_parquet(args.results / "training" / "features" / f"{s}.parquet") for s in shots}
     check_design = pd.read_parquet(args.results / "check" / "design.parquet")

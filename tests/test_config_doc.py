@@ -44,7 +44,7 @@ def test_page_has_a_row_per_key():
     for key in schema_keys(load_schema()):
         if len(key.path) > 1:
             assert f"| `{key.name}` |" in page, key.name
-    assert "| `hydro.end_time_us` | number or `auto` | *required* | us | > 0 |" in page
+    assert "| `hydro.end_time_us` | number or string | *required* | us | > 0 or one of `auto`, `per_run` |" in page
     assert "| `figures.formats` | list of string | `[png, pdf]` |  | each one of `png`, `pdf`, `svg` |" in page
 
 

@@ -42,3 +42,53 @@ def test_auto_end_time_keeps_every_feature(paper_config, runs):
     times = [c for c in reference.columns if c.startswith("t_")]
     assert np.abs(auto[speeds] - reference[speeds]).to_numpy().max() <= 0.05          # m/s
     assert np.abs(auto[times] - reference[times]).to_numpy().max() <= 0.0005          # us
+
+
+# --- `per_run`: each run ends after its own rise -------------------------------------------------------------
+
+def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
+    """The kernel stops `stop_after_rise_us` after the first output above rise_fraction x the impact velocity:
+    the same steps as the longer run up to there, so the same outputs bit for bit, and fewer of them."""
+    from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
+
+    params = ShotParameters(A_MPa=170, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
+    coarse = HydroSettings(cell_size_um=20.0)
+    full = run_shot(params, Geometry(3.95, 5.965, 2.30), settings=coarse)
+    short = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=1.2, rise_fraction=0.003),
+                     settings=coarse)
+    n = len(short.t_us)
+    rise = full.t_us[np.argmax(full.v_m_s > 0.003 * 204)]
+    assert short.status == full.status == "ok" and n < len(full.t_us)
+    assert short.t_us[-1] <= rise + 1.2 < full.t_us[n]                       # the last output within rise + 1.2 us
+    np.testing.assert_array_equal(short.v_m_s, full.v_m_s[:n])
+    np.testing.assert_array_equal(short.energy_history, full.energy_history[:n])
+    assert short.n_steps < full.n_steps
+    late = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=5.0, rise_fraction=0.003), settings=coarse)
+    np.testing.assert_array_equal(late.v_m_s, full.v_m_s)                   # end_us comes first
+
+
+def test_a_stop_after_the_rise_needs_both_settings():
+    from shockcal.errors import InputError
+    from shockcal.hydro import Geometry
+
+    with pytest.raises(InputError, match="Geometry.stop_after_rise_us and Geometry.rise_fraction: give both"):
+        Geometry(3.95, 5.965, 2.3, stop_after_rise_us=1.2)
+    with pytest.raises(InputError, match="Geometry.rise_fraction"):
+        Geometry(3.95, 5.965, 2.3, stop_after_rise_us=1.2, rise_fraction=-0.1)
+
+
+@pytest.mark.parametrize("runs", [pytest.param(CORNERS, id="corners"),
+                                  pytest.param(None, id="all", marks=pytest.mark.slow)])
+def test_per_run_end_keeps_the_auto_runs_features(paper_config, runs):
+    """`per_run` ends each run the window plus 0.1 us after its free surface passes 0.3% of its impact velocity,
+    no later than the extractor's arrival (its threshold on a trace at rest is 0.2% of the rise, and the rise
+    stays below 1.5x the impact velocity): the features equal `auto`'s bit for bit on the late-arrival corners."""
+    from shockcal.study.config import PER_RUN_RISE_FRACTION
+    from shockcal.velocimetry.features import QUIET_ARRIVAL_FRACTION
+
+    assert PER_RUN_RISE_FRACTION == pytest.approx(1.5 * QUIET_ARRIVAL_FRACTION)
+    auto = features_at(paper_config, "auto", runs).set_index(["shot", "run"]).sort_index()
+    per_run = features_at(paper_config, "per_run", runs).set_index(["shot", "run"]).sort_index()
+    assert (per_run["status"] == "ok").all(), per_run.loc[per_run["status"] != "ok", "reason"]
+    columns = [c for c in auto.columns if c.startswith(("t_", "v_"))]
+    pd.testing.assert_frame_equal(per_run[columns], auto[columns], check_exact=True)

@@ -68,18 +68,22 @@ def test_models_reduced_runs_each_law_to_its_predictive_runs(tmp_path):
 
 
 @pytest.mark.slow   # 4 s; the Makefile's wiring is the same as models-reduced's (the test above)
-def test_models_sequential_runs_each_law_in_waves(tmp_path):
-    """`make models-sequential`: config/sequential.yaml over the paper's config, each law's runs in waves (its
-    steps' emulators and posteriors), to its joint posterior and its emulator scored on the predictive runs."""
-    printed = make_dry_run("models-sequential", MODELS="johnson-cook ptw", MODELS_DIR=tmp_path)
+def test_models_runs_each_law_in_waves_and_models_paper_on_the_papers_design(tmp_path):
+    """`make models`: config/sequential.yaml over the paper's config, each law's runs in waves (its steps'
+    emulators and posteriors), to its joint posterior and its emulator scored on the predictive runs; `make
+    models-paper`: the paper's config alone, into results/models-paper."""
+    printed = make_dry_run("models", MODELS="johnson-cook ptw", MODELS_DIR=tmp_path)
     command = law_command(printed, "ptw")
-    assert command[command.index("--configfile") + 1:][:2] == ["config/config.yaml", "config/sequential.yaml"]
+    assert command[command.index("--configfile") + 1:][:3] == ["config/config.yaml", "config/sequential.yaml", "--config"]
     dry = subprocess.run([SNAKEMAKE, "--dry-run", *command[1:]], cwd=REPO, capture_output=True, text=True)
     assert dry.returncode == 0, dry.stdout[-2000:] + dry.stderr[-2000:]
     for rule in ("wave_design", "wave_calibrate", "report_heldout"):
         assert f"rule {rule}:" in dry.stdout, rule
     waves = re.findall(r"wildcards: run_set=wave(\d), shot=", dry.stdout)
     assert sorted(set(waves)) == ["1", "2"]
+    paper = law_command(make_dry_run("models-paper", MODELS="ptw"), "ptw")
+    assert paper[paper.index("--configfile") + 1:][:2] == ["config/config.yaml", "--config"]
+    assert "study={results_dir: results/models-paper/ptw}" in paper
 
 
 def test_models_quick_is_the_paper_config_with_the_quick_overlay(tmp_path):

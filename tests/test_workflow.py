@@ -412,6 +412,31 @@ def test_make_quick_names_its_target_before_the_configfile():
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
 
 
+def make_lines(*args: str) -> list[str]:
+    """The lines `make -n ARGS` prints (the environment's install step taken as done)."""
+    return subprocess.run(["make", "-n", "-o", ".venv/.installed", *args], cwd=REPO, capture_output=True, text=True,
+                          check=True).stdout.splitlines()
+
+
+def test_make_study_runs_the_waves_and_make_paper_the_papers_design():
+    """The default study is the sequential one (config/sequential.yaml over the paper's config, results/sequential);
+    `make paper`, or STUDY=paper for study, check and next-shot, runs the paper's design into results; another
+    STUDY is refused in one line before anything runs."""
+    runs = [line for line in make_lines("study") if line.startswith("snakemake ")]
+    assert runs[0].endswith("--cores all all --configfile config/sequential.yaml") and "results/sequential/" in runs[0]
+    paper = [line for line in make_lines("study", "STUDY=paper") if line.startswith("snakemake ")]
+    assert paper[0].split()[-2:] == ["all", "all"] and "--logger-shockcal-log-dir results/logs/" in paper[0]
+    assert "make --no-print-directory study STUDY=paper" in make_lines("paper")
+    for target, rule in (("check", "check"), ("next-shot", "next_shot"), ("next-shot-check", "next_shot_check")):
+        assert any(line.endswith(f" {rule} --configfile config/sequential.yaml") for line in make_lines(target)), target
+        assert any(line.rstrip().endswith(f" {rule}") and "results/logs/" in line
+                   for line in make_lines(target, "STUDY=paper")), target
+    done = subprocess.run(["make", "-n", "study", "STUDY=lhs"], cwd=REPO, capture_output=True, text=True)
+    assert done.returncode != 0 and done.stderr.strip().endswith("STUDY=lhs: sequential (the default) or paper.  Stop.")
+    dry = subprocess.run([SNAKEMAKE, "--dry-run", *runs[0].split()[1:]], cwd=REPO, capture_output=True, text=True)
+    assert dry.returncode == 0 and "rule wave_design:" in dry.stdout, dry.stdout[-2000:] + dry.stderr[-2000:]
+
+
 def test_the_next_shot_check_without_a_ranking_stops_with_one_line(tmp_path):
     """`snakemake next_shot_check` compares the ranking's best and worst: with no ranking.csv it stops before any job."""
     fresh = overlay(tmp_path / "fresh.yaml", study={"results_dir": str(tmp_path / "results")})

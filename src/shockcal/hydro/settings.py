@@ -29,16 +29,24 @@ class Geometry:
         initial_temperature_K: temperature of both plates before impact (K); None: the material's
             T_ref_K (a room-temperature shot). Hotter plates start expanded, at zero pressure
             (`MaterialProperties.initial_state`).
+        stop_after_rise_us: end the run this long (us) after its free-surface velocity first exceeds
+            `rise_fraction` x its impact velocity, or at end_us if sooner; None: at end_us.
+        rise_fraction: that share of the impact velocity (-), with stop_after_rise_us.
     """
 
     flyer_mm: float
     target_mm: float
     end_us: float
     initial_temperature_K: float | None = None
+    stop_after_rise_us: float | None = None
+    rise_fraction: float | None = None
 
     def __post_init__(self):
         check_fields(self, {"flyer_mm": "positive", "target_mm": "positive", "end_us": "positive",
-                            "initial_temperature_K": "positive"})
+                            "initial_temperature_K": "positive", "stop_after_rise_us": "positive",
+                            "rise_fraction": "positive"})
+        if (self.stop_after_rise_us is None) != (self.rise_fraction is None):
+            raise InputError("Geometry.stop_after_rise_us and Geometry.rise_fraction: give both or neither")
 
 
 @dataclass(frozen=True)

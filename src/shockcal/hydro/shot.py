@@ -52,7 +52,7 @@ STUDY_NUMERICS = HydroSettings()
 
 def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties = AL5083,
              settings: HydroSettings = STUDY_NUMERICS) -> RunResult:
-    """Simulate one symmetric shot to `geometry.end_us`.
+    """Simulate one symmetric shot to `geometry.end_us` (or its end after the free surface's rise).
 
     Args:
         params: Johnson-Cook parameters, impact velocity and shear modulus (`ShotParameters`, user units),
@@ -73,8 +73,11 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
     velocity, strength = kernel_strength(params, material)
     initial = material.initial_state(geometry.initial_temperature_K)
     dx = settings.cell_size_um * UM_TO_CM
+    stops_after_rise = geometry.stop_after_rise_us is not None
     kernel_args = dict(nf=nf, nt=nt, dx=dx, velocity=velocity, initial=initial, strength=strength,
-                       material=material.code_units(), numerics=settings.numerics(), t_out=t_out)
+                       material=material.code_units(), numerics=settings.numerics(), t_out=t_out,
+                       rise_threshold=geometry.rise_fraction * velocity if stops_after_rise else np.inf,
+                       after_rise=geometry.stop_after_rise_us if stops_after_rise else np.inf)
     load_kernel(simulate, tuple(kernel_args.values()))
     start = time.perf_counter()
     out = simulate(**kernel_args)
@@ -84,11 +87,12 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         where = f" in cell {out.fail_cell}" if out.fail_cell >= 0 else ""
         body = "" if out.fail_cell < 0 else (" (flyer)" if out.fail_cell < nf else " (target)")
         reason = f"{FAILURE_REASONS[out.status]}{where}{body} at t = {out.fail_time:.5f} us after {out.n_steps} steps"
-    energy = out.energy
+    energy = out.energy[: out.n_out]
     reached = energy[: max(1, np.count_nonzero(energy) or 1)]
     internal0 = initial.E * initial.rho * dx * (nf + nt)      # the plates' initial internal energy (0 at T_ref)
     energy_error = float(np.max(np.abs(reached - energy[0])) / (energy[0] - internal0))
-    return RunResult(t_out, out.v_free_surface * CM_US_TO_M_S, "ok" if out.status == STATUS_OK else "failed", reason,
+    return RunResult(t_out[: out.n_out], out.v_free_surface[: out.n_out] * CM_US_TO_M_S,
+                     "ok" if out.status == STATUS_OK else "failed", reason,
                      out.max_plastic_rate, out.max_temperature, out.max_plastic_strain, energy_error,
                      int(out.n_steps), wall, energy)
 

@@ -225,9 +225,17 @@ def grow_window(sigma, lo, hi):
 
 
 @njit(cache=True, error_model="numpy")
-def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out):
-    """Run to t_out[-1] (us): a `KernelResult` (free-surface velocity and total energy at t_out, status,
-    failed cell and time, steps, the maxima over the target's cells).
+def outputs_until(t_out, t_end):
+    """How many of the output times t_out (us, increasing) lie at or before t_end (us)."""
+    return np.searchsorted(t_out, t_end, side="right")
+
+
+@njit(cache=True, error_model="numpy")
+def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out, rise_threshold, after_rise):
+    """Run to t_out[-1] (us), or to `after_rise` past the first output whose free-surface velocity exceeds
+    `rise_threshold`: a `KernelResult` (free-surface velocity and total energy at t_out, status, failed cell
+    and time, steps, the maxima over the target's cells, how many outputs the run was to reach). A run that
+    ends after the rise takes the same steps as the longer run up to its end, so its outputs are that run's.
 
     Args:
         nf, nt: cells across the flyer and the target.
@@ -238,6 +246,8 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out)
         material: `Material` (code units).
         numerics: `Numerics` (artificial viscosity, CFL, time steps in us).
         t_out: output times (us), t_out[0] = 0.
+        rise_threshold: free-surface velocity (cm/us) whose first crossing starts the end's countdown; inf: never.
+        after_rise: simulated time (us) after that output; the run ends at the last output time within it.
     """
     nodes, cells = initial_mesh(nf, nt, dx, velocity, initial, strength, material)
     u = nodes.u
@@ -255,6 +265,7 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out)
     u_fs_prev, t_fs_prev = 0.0, 0.0
     lo, hi = gap, gap + 1                       # active nodes
     steps = 0
+    risen = False                               # the free surface has passed rise_threshold
     while k_out < n_out:
         approach_speed = u[gap] - u[gap + 1]
         accelerate_nodes(nodes, cells.sigma, lo, hi, dt)
@@ -262,7 +273,7 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out)
         status, cell, max_signal_rate = update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics,
                                                      peaks)
         if status != STATUS_OK:
-            return KernelResult(v_out, energy_out, status, cell, t, steps, peaks[0], peaks[1], peaks[2])
+            return KernelResult(v_out, energy_out, status, cell, t, steps, peaks[0], peaks[1], peaks[2], n_out)
         lo, hi = grow_window(cells.sigma, lo, hi)
         # free-surface velocity (time-centred at t + dt/2), linearly interpolated onto t_out
         t_mid = t + 0.5 * dt
@@ -270,11 +281,15 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out)
             w = (t_out[k_out] - t_fs_prev) / (t_mid - t_fs_prev)
             v_out[k_out] = u_fs_prev + w * (u[N + 1] - u_fs_prev)
             energy_out[k_out] = total_energy(nodes, cells)
+            if not risen and v_out[k_out] > rise_threshold:
+                n_out = min(n_out, outputs_until(t_out, t_out[k_out] + after_rise))
+                risen = True
             k_out += 1
         u_fs_prev, t_fs_prev = u[N + 1], t_mid
         t += dt
         steps += 1
         dt = min(numerics.cfl / max_signal_rate, DT_GROWTH * dt)
         if dt < DT_FLOOR_US:
-            return KernelResult(v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2])
-    return KernelResult(v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2])
+            return KernelResult(v_out, energy_out, STATUS_DT_COLLAPSE, -1, t, steps, peaks[0], peaks[1], peaks[2],
+                                n_out)
+    return KernelResult(v_out, energy_out, STATUS_OK, -1, t, steps, peaks[0], peaks[1], peaks[2], n_out)

@@ -82,6 +82,7 @@ class KernelResult(NamedTuple):
     max_plastic_rate: float      # 1/us, over the target's cells
     max_temperature: float       # K
     max_plastic_strain: float
+    n_out: int                   # outputs the run was to reach: len(t_out), or fewer once it ended after the rise
 
 
 class Nodes(NamedTuple):

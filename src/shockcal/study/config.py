@@ -7,7 +7,11 @@ import math
 from shockcal.errors import ConfigError
 from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S, user_columns, user_units
 
-AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto`: simulated time beyond the latest end of the analysis window
+AUTO_END_MARGIN_US = 0.1   # `hydro.end_time_us: auto` and `per_run`: simulated time beyond the end of the analysis window
+# `per_run`: a run ends after its free surface passes this share of its impact velocity: the extractor's arrival
+# threshold on a trace at rest (velocimetry.features.QUIET_ARRIVAL_FRACTION, 0.002 of the rise) times 1.5, a bound
+# of the rise over the impact velocity (the plateau lies within 0.85-1.05 of it), so the arrival comes no later
+PER_RUN_RISE_FRACTION = 0.003
 
 
 def shot_config(config: dict, shot: str) -> dict:
@@ -19,13 +23,13 @@ def shot_config(config: dict, shot: str) -> dict:
 
 
 def end_time_us(config: dict, shot: dict) -> float:
-    """Simulated time of a run of `shot` (us): `hydro.end_time_us`, or with `auto` the latest time
-    the feature extractor can need. The free surface starts to move no later than target / c0 after
+    """Simulated time of a run of `shot` (us): `hydro.end_time_us`, or with `auto` (and at most, with
+    `per_run`) the latest time the feature extractor can need. The free surface starts to move no later than target / c0 after
     impact (the elastic precursor travels faster than the bulk sound speed c0 = sqrt(c1 / rho0));
     the analysis window ends `window_after_arrival_us` later; AUTO_END_MARGIN_US is added. A run whose
     window still reaches past its end fails in the extractor with a reason, never silently."""
     requested = config["hydro"]["end_time_us"]
-    if requested != "auto":
+    if requested not in ("auto", "per_run"):
         return float(requested)
     return analysis_end_us(config, shot) + AUTO_END_MARGIN_US
 

@@ -38,7 +38,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the hypercube of the synthetic-truth check's hydrocode runs (--n-runs calibration.check.trials)
     "check_design": ("study.seed", "inputs", "calibration.check.trials", "design.base_shots", "checks.design_box",
                      *_SHOT_MAPPING),
-    # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto
+    # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto or per_run
     "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?", "simulator?",
                  *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
                  "shots.{shot}.analysis.window_after_arrival_us"),
