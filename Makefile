@@ -66,14 +66,14 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # in order, the paper's config/config.yaml first (compare-models and model-predictions read the shots and records from it)
 # The laws' studies run side by side, MODEL_JOBS at a time, each snakemake with --cores MODEL_CORES, the costliest
 # first (MODEL_ORDER). By default the machine's cores (CORES, or nproc's count for `all`) are split between up to
-# four laws: on 2 cores two laws at a time, one job each, so every core runs one job from start to end (no core
-# idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each. Each line of a
+# four laws (no more than MODELS has): on 2 cores two laws at a time, one job each, so every core runs one job from
+# start to end (no core idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each. Each line of a
 # study's console starts with its law. MODEL_JOBS=1 runs them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml config/sequential.yaml
 MODELS_DIR ?= results/models
-MACHINE_CORES := $(if $(filter all,$(CORES)),$(shell nproc),$(CORES))
-MODEL_JOBS ?= $(shell echo $$(( $(MACHINE_CORES) < 4 ? $(MACHINE_CORES) : 4 )))
+MACHINE_CORES := $(if $(filter all,$(CORES)),$(shell nproc 2>/dev/null || getconf _NPROCESSORS_ONLN 2>/dev/null || echo 1),$(CORES))
+MODEL_JOBS ?= $(shell n=$(MACHINE_CORES); l=$(words $(MODELS)); n=$$(( n < l ? n : l )); echo $$(( n < 4 ? n : 4 )))
 MODEL_CORES ?= $(shell echo $$(( $(MACHINE_CORES) / $(MODEL_JOBS) > 1 ? $(MACHINE_CORES) / $(MODEL_JOBS) : 1 )))
 MODEL_ORDER := ptw steinberg-guinan johnson-cook zerilli-armstrong
 
@@ -98,20 +98,20 @@ models-paper: $(INSTALLED)  ## the same on the paper's design (1000 training and
 models-reduced: $(INSTALLED)  ## the paper's design at 150 training and 30 predictive runs per shot (config/models-reduced.yaml) into results/models-reduced
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/models-reduced.yaml" MODELS_DIR=$(if $(filter command line,$(origin MODELS_DIR)),$(MODELS_DIR),results/models-reduced)
 
-models-quick: $(INSTALLED)  ## the same at toy size (config/quick.yaml) into results/models-quick
+models-quick: $(INSTALLED)  ## the paper's design at toy size (config/quick.yaml) into results/models-quick
 	$(MAKE) models MODELS_CONFIG="config/config.yaml config/quick.yaml" MODELS_DIR=results/models-quick
 
 check: $(INSTALLED)  ## synthetic-truth coverage checks of the study (calibration.check.trials per check; STUDY=paper: the paper's)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) check $(STUDY_CONFIG)
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
-	@echo "report:  their table joins $(CURDIR)/$(STUDY_DIR)/report.html at the next make study"
+	@echo "report:  their table joins $(CURDIR)/$(STUDY_DIR)/report.html at the next make study$(if $(filter paper,$(STUDY)), STUDY=paper)"
 
 next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain (STUDY=paper: on the paper's study)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot $(STUDY_CONFIG)
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/next_shot/ranking.csv"
 	@echo "figure:  $(CURDIR)/$(STUDY_DIR)/figures/next_shot.png"
 
-next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: its best and worst candidates on truths from the posterior
+next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: its best and worst candidates on truths from the posterior (STUDY=paper: the paper's)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot_check $(STUDY_CONFIG)
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/next_shot/check_summary.csv (per trial: check.csv)"
 

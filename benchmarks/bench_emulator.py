@@ -5,7 +5,7 @@ features (runs 0-499, real data), fit + K-fold + outer-check wall time and the R
 of each scheme; fit + K-fold on 1000 runs (the paper's design with a smooth synthetic 12-feature
 response, since FLAG features exist only for 500 runs); the time to predict mean and covariance of
 all 12 features at 1000 inputs on one and two threads; the same on our own runs when
-`results/training/features` holds them.
+`results/training/features` holds them (the paper's study, `make paper`).
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Calibration speed: likelihood evaluations per second, where an evaluation's time goes,
 and the joint calibration's wall time, each beside the figure before 2026-11-26 ("before") measured in the same run.
 
-On the study's emulator and measured features (`results/emulator`, `results/features/observed.parquet`;
-skipped without them), at points drawn from the joint posterior's weighted draws
+On the paper study's emulator and measured features (`make paper`: `results/emulator`,
+`results/features/observed.parquet`; skipped without them), at points drawn from the joint posterior's weighted draws
 (`results/posterior/joint_weighted.parquet`; else uniform on the prior box), in batches of 100 points
 (nautilus's batch):
   likelihood  evaluations per second of the joint likelihood (12 features, 11 inputs), and per point

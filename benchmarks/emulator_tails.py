@@ -12,7 +12,9 @@ box, the mean d^2 / F of the check runs and the mean z^2 of the K-fold errors of
 (results/emulator/cv_heldout.parquet), both 1 when the sds are right. The shots and the noise's sd
 fraction come from the study's config; the noise is drawn as the check draws it. Needs `make check`'s
 check runs and the emulator under the results directory; prints, never asserts.
-Usage: python benchmarks/emulator_tails.py [RESULTS_DIR [CONFIG]]
+Usage: python benchmarks/emulator_tails.py [RESULTS_DIR [CONFIG]] (default results and config/config.yaml, the paper's
+study after `make paper` and `make check STUDY=paper`; the default study: results/sequential and its
+results/sequential/config/effective.yaml)
 """
 
 import sys
@@ -59,7 +61,7 @@ def share_beyond_90_with_noise(eta, cov, err, model: ErrorModel, sd_fraction, rn
 
 def main(results: Path, config_path: Path) -> int:
     if not (results / "check" / "design.parquet").exists():
-        print(f"skipped: no check runs under {results} (run `make check` first)")
+        print(f"skipped: no check runs under {results} (run `make check STUDY=paper` first)")
         return 0
     config = load_config(config_path)
     shots, sd_fraction = list(config["shots"]), config["observed"]["sd_fraction"]

@@ -65,7 +65,11 @@ def test_an_edit_of_a_callee_or_a_constant_reaches_the_cached_caller(tmp_path):
     package = toy_package(tmp_path, value=1)
     assert twice_in_a_new_process(tmp_path) == 2
     assert list((package / "__pycache__").glob("numba-*/**/*.nbi")), "nothing was cached"
+    old_folder = next((package / "__pycache__").glob("numba-*"))
     toy_package(tmp_path, value=5)                       # caller.py untouched: numba's own key would load 2
+    # a child of a process started before the edit inherits its folder, and sets its own
+    inherited = {"NUMBA_CACHE_DIR": str(old_folder), DIGEST_VARIABLE: old_folder.name.removeprefix("numba-")}
+    assert twice_in_a_new_process(tmp_path, **inherited) == 10
     assert twice_in_a_new_process(tmp_path) == 10
     toy_package(tmp_path, value=5, offset=1)            # a constant in a module without numba
     assert twice_in_a_new_process(tmp_path) == 12
@@ -78,6 +82,8 @@ def test_numbas_own_key_misses_the_callee_edit_so_the_test_above_can_fail(tmp_pa
     assert twice_in_a_new_process(tmp_path, NUMBA_CACHE_DIR=user_cache) == 2
     toy_package(tmp_path, value=5)
     assert twice_in_a_new_process(tmp_path, NUMBA_CACHE_DIR=user_cache) == 2
+    # the user's folder in a child of a shockcal process (the digest variable inherited) is still the user's
+    assert twice_in_a_new_process(tmp_path, NUMBA_CACHE_DIR=user_cache, **{DIGEST_VARIABLE: "0" * 12}) == 2
     assert not list((tmp_path / "toy" / "__pycache__").glob("numba-*"))
 
 

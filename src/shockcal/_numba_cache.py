@@ -4,12 +4,14 @@ numba keys a cached kernel on the file that defines it (that file's modification
 the files of the kernels it calls: after an edit of `hydro/plastic_return.py` or a strength law (or a
 `git pull` that changes them), `hydro/solver.simulate` would load machine code compiled from the old
 callee. shockcal therefore points numba's cache (`NUMBA_CACHE_DIR`) at a folder named by a digest of
-every package file that uses numba: any change to a kernel file compiles afresh, an unchanged tree loads
-what it compiled. The folder is `__pycache__/numba-<digest>` inside the package (`~/.cache/shockcal/`
-when the package is read-only); the most recent `KEPT_STALE_FOLDERS` others are kept, older ones removed.
+every package file that imports numba and of the package modules those import (`kernel_files`): any
+change to them compiles afresh, an unchanged tree loads what it compiled. The folder is
+`__pycache__/numba-<digest>` inside the package (`~/.cache/shockcal/` when the package is read-only);
+the most recent `KEPT_STALE_FOLDERS` others are kept, older ones removed.
 
-A `NUMBA_CACHE_DIR` the user set is left alone. The one shockcal sets is marked by `DIGEST_VARIABLE`, so a
-process started from an older tree (a job of a snakemake started before an edit) sets its own.
+A `NUMBA_CACHE_DIR` the user set is left alone. The one shockcal sets is named by the digest it exports in
+`DIGEST_VARIABLE`, so a process started from an older tree (a job of a snakemake started before an edit) sets
+its own.
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ import os
 import re
 import shutil
 import sys
+import tempfile
+import warnings
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent
@@ -57,9 +61,17 @@ def kernel_digest(package: Path = PACKAGE) -> str:
     return digest.hexdigest()[:12]
 
 
-def cache_root(package: Path = PACKAGE) -> Path:
-    """Where the digest folders live: the package's __pycache__, or ~/.cache/shockcal if it is read-only."""
-    return package / "__pycache__" if os.access(package, os.W_OK) else Path.home() / ".cache" / "shockcal"
+def writable_root(package: Path = PACKAGE) -> Path | None:
+    """Where the digest folders live: the package's __pycache__, else ~/.cache/shockcal (a read-only install);
+    the first one that can be created and written, or None."""
+    for root in (package / "__pycache__", Path.home() / ".cache" / "shockcal"):
+        try:
+            root.mkdir(parents=True, exist_ok=True)
+            tempfile.TemporaryFile(dir=root).close()
+            return root
+        except OSError:
+            continue
+    return None
 
 
 def remove_stale_folders(root: Path, current: Path, kept: int = KEPT_STALE_FOLDERS) -> None:
@@ -71,17 +83,23 @@ def remove_stale_folders(root: Path, current: Path, kept: int = KEPT_STALE_FOLDE
 
 def use_kernel_keyed_cache(package: Path = PACKAGE) -> Path | None:
     """Point numba's cache at this tree's digest folder (module docstring) and return it; None when the user
-    set NUMBA_CACHE_DIR. Call before any kernel module is imported (shockcal's __init__ does)."""
-    if "NUMBA_CACHE_DIR" in os.environ and DIGEST_VARIABLE not in os.environ:
-        return None
+    set NUMBA_CACHE_DIR, or when no folder can be written (numba's own per-file key then, with a warning).
+    Call before any kernel module is imported (shockcal's __init__ does). Imported after numba, it makes numba
+    re-read its NUMBA_* variables, so numba settings made in code before that are lost: import shockcal first."""
+    current = os.environ.get("NUMBA_CACHE_DIR")
+    if current is not None and Path(current).name != FOLDER_PREFIX + os.environ.get(DIGEST_VARIABLE, ""):
+        return None                                         # the user's cache
     digest = kernel_digest(package)
-    root = cache_root(package)
+    root = writable_root(package)
+    if root is None:
+        warnings.warn("shockcal: no writable folder for numba's cache keyed on the kernel files; numba keys each "
+                      "kernel on its own file, so after an edit of a callee delete the cached kernels", stacklevel=2)
+        return None
     folder = root / f"{FOLDER_PREFIX}{digest}"
-    if os.environ.get(DIGEST_VARIABLE) != digest:
+    if current != str(folder):
         os.environ["NUMBA_CACHE_DIR"] = str(folder)
         os.environ[DIGEST_VARIABLE] = digest
-        if root.is_dir():
-            remove_stale_folders(root, folder)
+        remove_stale_folders(root, folder)
         if "numba.core.config" in sys.modules:            # numba read its settings before shockcal was imported
             sys.modules["numba.core.config"].reload_config()
     return folder

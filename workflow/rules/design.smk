@@ -40,15 +40,16 @@ RUN_SET_SIZES.update(zip(WAVES, wave_sizes(config)[1:]))
 
 # The next-shot check (next_shot_check.smk): each compared candidate as the fourth shot of a study derived from
 # the config (its config file and training design: the study's, the candidate's inputs drawn as new columns),
-# planned here as the training design is. Without a ranking yet there is none, unless the check is the target on
-# the command line (snakemake has not read its targets yet when it reads this file): then it stops with one line.
+# planned here as the training design is. Without a ranking yet, or with settings that do not fit the study, there
+# is none, unless the check is a target on the command line (its rule, or a file of its own; snakemake has not read
+# its targets yet when it reads this file): then it stops with one line.
 try:
     CHECK_PLANS = plan_check(
         config,
         f"{RESULTS}/next_shot/ranking.csv",
         DESIGN,
         run_set_path("next_shot_check"),
-        required="next_shot_check" in sys.argv[1:],
+        required=any("next_shot_check" in word or "next_shot/check" in word for word in sys.argv[1:]),
     )
 except ShockcalError as exc:
     raise SystemExit(f"shockcal: error: {exc}") from None

@@ -37,7 +37,7 @@ rule report_tables:
 
 rule report_coverage:
     """The coverage table of `make check`'s merged tables. They are read, not declared as inputs: as inputs they
-    would send `all` through the checks again (2 h 45 min on the default study) whenever the emulator is
+    would send `all` through the checks again (2 h 45 min on the paper's study) whenever the emulator is
     refitted. Their modification times in `params` rerun the table when a check is redone."""
     output:
         report(f"{RESULTS}/report/coverage.html", caption="../report/coverage.rst", category="4 posterior"),
