@@ -67,8 +67,8 @@ flag-archive: $(INSTALLED)  ## the paper's FLAG runs (the data release's design 
 # The laws' studies run side by side, MODEL_JOBS at a time, each snakemake with --cores MODEL_CORES, the costliest
 # first (MODEL_ORDER). By default the machine's cores (CORES, or nproc's count for `all`) are split between up to
 # four laws (no more than MODELS has): on 2 cores two laws at a time, one job each, so every core runs one job from
-# start to end (no core idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each. Each line of a
-# study's console starts with its law. MODEL_JOBS=1 runs them one after another.
+# start to end (no core idles while a law calibrates, none runs two jobs); on 8 cores four laws with 2 cores each.
+# Each line of a study's console starts with its law. MODEL_JOBS=1 runs them one after another.
 MODELS ?= johnson-cook steinberg-guinan ptw zerilli-armstrong
 MODELS_CONFIG ?= config/config.yaml config/sequential.yaml
 MODELS_DIR ?= results/models

@@ -57,6 +57,7 @@ def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
     short = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=1.2, rise_fraction=0.003),
                      settings=coarse)
     n = len(short.t_us)
+    # bit for bit: one code path in one process, the same steps and arithmetic, only stopped sooner
     rise = full.t_us[np.argmax(full.v_m_s > 0.003 * 204)]
     assert short.status == full.status == "ok" and n < len(full.t_us)
     assert short.t_us[-1] <= rise + 1.2 < full.t_us[n]                       # the last output within rise + 1.2 us
