@@ -7,7 +7,8 @@ structures (`EmulatorSpec.structure`, config `emulator.structure`):
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
 A shot in `EmulatorSpec.own_blocks` (a new shot with runs of its own) gets a block of its own in either.
-An `InputMap` says how a block's inputs derive from design columns (sums, and the powers eps^n and T*^m).
+An `InputMap` says how a block's inputs derive from design columns (sums, the powers eps^n and T*^m, and
+ln of the law's yield stress, `shockcal.emulator.yield_input`).
 
 Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units,
 settings, hyperparameters); loading rebuilds the Cholesky factors, so files stay small and no live
@@ -28,6 +29,7 @@ import pandas as pd
 from shockcal.design.tables import ShotMapping
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
+from shockcal.emulator.yield_input import YieldInput
 from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path
 from shockcal.plausibility import outside_box
@@ -44,22 +46,32 @@ class InputMap:
     """How one emulator's inputs derive from design inputs: each is a sum of design columns, then
     one input base^column for each entry of `powers`: the Johnson-Cook factors eps^n at a plastic
     strain eps and T*^m at a homologous temperature T*. Both are steep near n = 0 and m = 0, where
-    the features change fastest, and smooth and monotone everywhere."""
+    the features change fastest, and smooth and monotone everywhere. Last, with `yield_input`, ln of the
+    law's yield stress (`YieldInput`), scaled by its range over the training runs (`with_yield`)."""
 
     names: list[str]            # emulator input names, e.g. [A, B, C, n, m, V2, G_105S]
     terms: list[list[str]]      # design columns summed into each input
-    lower: np.ndarray           # box of each input (sum of the terms' bounds), the powers last
+    lower: np.ndarray           # box of each input (sum of the terms' bounds), the powers, then the yield last
     upper: np.ndarray
     powers: list[tuple[float, str]] = field(default_factory=list)   # (base, design column)
+    yield_input: YieldInput | None = None
 
     def design_inputs(self) -> list[str]:
         return list(dict.fromkeys(t for terms in self.terms for t in terms))
 
     def raw(self, inputs) -> np.ndarray:
-        """(N, d) inputs (sums of design columns, strain^n) from a mapping or DataFrame of design columns."""
+        """(N, d) inputs (sums of design columns, strain^n, ln yield) from a mapping or DataFrame of design columns."""
         raw = [sum(np.asarray(inputs[t], dtype=float) for t in terms) for terms in self.terms]
         raw += [base ** np.asarray(inputs[column], dtype=float) for base, column in self.powers]
+        if self.yield_input is not None:
+            raw.append(self.yield_input.values(inputs))
         return np.column_stack(raw)
+
+    def with_yield(self, yield_input: YieldInput, table: pd.DataFrame) -> InputMap:
+        """This map with `yield_input` last, its box the range it takes over the runs of `table`."""
+        values = yield_input.values(table)
+        return replace(self, lower=np.append(self.lower, values.min()), upper=np.append(self.upper, values.max()),
+                       yield_input=yield_input)
 
     def scaled(self, inputs) -> np.ndarray:
         """(N, d) inputs scaled to [0, 1] by the box."""
@@ -67,12 +79,15 @@ class InputMap:
 
     def to_json(self) -> dict:
         return {"names": self.names, "terms": self.terms, "lower": self.lower.tolist(), "upper": self.upper.tolist(),
-                "powers": [list(p) for p in self.powers]}
+                "powers": [list(p) for p in self.powers],
+                "yield_input": None if self.yield_input is None else self.yield_input.to_json()}
 
     @classmethod
     def from_json(cls, d: dict) -> InputMap:
+        yield_input = d.get("yield_input")
         return cls(d["names"], d["terms"], np.array(d["lower"]), np.array(d["upper"]),
-                   [(float(b), str(c)) for b, c in d["powers"]])
+                   [(float(b), str(c)) for b, c in d["powers"]],
+                   None if yield_input is None else YieldInput.from_json(yield_input))
 
 
 def shot_input_map(shot: ShotMapping, bounds: Mapping[str, tuple[float, float]], powers=()) -> InputMap:
@@ -108,7 +123,8 @@ class EmulatorSpec:
     reads the design, the prior box by design input (native units), the extra power inputs (base,
     design column; `InputMap`), the GP settings, whose seed keys each block's own random stream, and the
     shots fitted on a block of their own in either structure (`own_blocks`: a new shot whose runs are not
-    the other shots' rows, `design.new_shots`)."""
+    the other shots' rows, `design.new_shots`), and the law's yield stress as a last input (`yield_input`,
+    config `emulator.yield_input`) or None."""
 
     structure: str
     shots: Mapping[str, ShotMapping]
@@ -116,6 +132,7 @@ class EmulatorSpec:
     powers: tuple[tuple[float, str], ...] = ()
     settings: Settings = field(default_factory=Settings)
     own_blocks: tuple[str, ...] = ()
+    yield_input: YieldInput | None = None
 
 
 @dataclass
@@ -141,7 +158,8 @@ class Emulator:
         self._shot_inputs = shot_inputs  # shot -> design inputs it depends on (SPEC section 3)
         self.source = "the emulator"     # its directory, once loaded (for messages)
         for block in blocks:             # the array emulator's inputs by name: the map's, then base^column
-            block.model._input_names = [*block.input_map.names, *(f"{base:g}^{column}" for base, column in block.input_map.powers)]
+            block.model._input_names = [*block.input_map.names, *(f"{base:g}^{column}" for base, column in block.input_map.powers),
+                                        *([YieldInput.name] if block.input_map.yield_input else [])]
 
     def __repr__(self) -> str:
         blocks = "; ".join(f"{'+'.join(b.shots)}: {len(b.runs)} runs, inputs {b.model.input_names}, "
@@ -406,6 +424,8 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
     blocks = []
     for i, (block_shots, input_map, table, label, columns) in enumerate(groups):
         _check_training_inputs(table, input_map, label)
+        if spec.yield_input is not None:
+            input_map = input_map.with_yield(spec.yield_input, table)
         settings = replace(spec.settings, seed=stream_seed(spec.settings.seed, "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
                                  settings, switches=single_wave_switches(len(block_shots)),

@@ -28,7 +28,7 @@ from shockcal.study.config import (
     velocity_box_m_s,
     wave_sizes,
 )
-from shockcal.study.strength import DEFAULT_MODEL, strength_model
+from shockcal.study.strength import DEFAULT_MODEL, strength_model, strength_parameters
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -148,14 +148,22 @@ def emulator_settings(config: dict) -> EmulatorSettings:
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
     """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
-    inputs eps^n and T*^m for Johnson-Cook only)."""
+    inputs eps^n and T*^m for Johnson-Cook only; the yield input for the laws of `emulator.yield_input`,
+    at material.T_ref_K)."""
     from shockcal.emulator.study_emulator import POWER_INPUTS, EmulatorSpec
+    from shockcal.emulator.yield_input import YieldInput
 
     section = config["emulator"]
-    jc = strength_model(config) == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
+    model = strength_model(config)
+    jc = model == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
     powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key] and jc)
-    return EmulatorSpec(section["structure"], {s: shot_mapping(config, s) for s in shots}, prior_bounds(config),
-                        powers, emulator_settings(config))
+    mappings = {s: shot_mapping(config, s) for s in shots}
+    yield_input = None
+    if model in section["yield_input"]["models"]:
+        yield_input = YieldInput(model, tuple(strength_parameters(config)), section["yield_input"]["strain_rate_per_s"],
+                                 config["material"]["T_ref_K"])
+    return EmulatorSpec(section["structure"], mappings, prior_bounds(config), powers, emulator_settings(config),
+                        yield_input=yield_input)
 
 
 def calibration_settings(config: dict, shots, check: bool = False) -> CalibrationSettings:

@@ -51,7 +51,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
                  "observed.readout_replicates", "features", "shots.*.analysis",
                  "checks.observed_units", "checks.plateau_vs_velocity", "inputs", "shots.*.velocity_input"),
     # the emulator fit and its cross-validation
-    "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", *_SHOT_MAPPING),
+    "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", "material.T_ref_K", *_SHOT_MAPPING),
     # the emulator's predictions at a design's runs
     "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # one calibration (single shot or joint)

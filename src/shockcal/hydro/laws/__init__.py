@@ -27,7 +27,7 @@ from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
 
 __all__ = ["LAWS", "Law", "Param", "code_parameters", "flow_stress_curve", "get_law", "melt_temperature_K",
-           "shear_modulus_gpa"]
+           "shear_modulus_gpa", "yield_stress_MPa"]
 
 
 def get_law(name: str) -> Law:
@@ -72,6 +72,29 @@ def flow_stress_curve(law: Law, values: Mapping[str, float], plastic_strains, st
     pressure = pressure_GPa / MBAR_TO_GPA
     return np.array([law.flow_stress(params, float(e), rate, float(temperature_K), pressure, float(density_ratio))
                      for e in np.asarray(plastic_strains, dtype=float)]) * MBAR_TO_MPA
+
+
+def yield_stress_MPa(law: Law, values: Mapping[str, np.ndarray], strain_rate_per_s: float,
+                     temperature_K: float) -> np.ndarray:
+    """The flow stress (MPa) at zero plastic strain of many parameter sets, at a constant equivalent strain
+    rate (1/s) and temperature (K), zero pressure and the reference density.
+
+    `values` maps the law's parameter names (user units, as `flow_stress_curve`) to arrays of one length
+    (scalars broadcast); declared defaults fill the material constants left out. The rows are not checked
+    against the law's constraints (`user_values` checks one set): this is the emulator's input map, which
+    evaluates the law at every sampler point of a box whose corners meet them."""
+    unknown = [k for k in values if k not in law.names()]
+    if unknown:
+        raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
+    missing = [p.name for p in law.params if p.name not in values and p.default is None]
+    if missing:
+        raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
+    by_field = {p.field: np.asarray(values.get(p.name, p.default), dtype=float) * p.to_code for p in law.params}
+    columns = np.broadcast_arrays(*(by_field[field] for field in law.code_type._fields))
+    rate, T = strain_rate_per_s * PER_S_TO_PER_US, float(temperature_K)
+    stress = np.array([law.flow_stress(law.code_type(*row), 0.0, rate, T, 0.0, 1.0)
+                       for row in zip(*(np.atleast_1d(c) for c in columns), strict=True)])
+    return stress.reshape(columns[0].shape) * MBAR_TO_MPA
 
 
 def shear_modulus_gpa(law: Law, values: Mapping[str, float], temperature_K: float, pressure_GPa: float = 0.0,
