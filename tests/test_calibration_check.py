@@ -254,6 +254,7 @@ def test_paired_coverage_counts_the_trials_one_check_alone_covers():
         paired_coverage(here, there.assign(status="failed"))
 
 
+@pytest.mark.slow
 def test_synthetic_truth_in_batches_equals_one_run(three_toy_trials):
     # each trial has its own random stream: the workflow's batches of trials are independent jobs
     emu, config, whole = three_toy_trials
@@ -353,6 +354,7 @@ def test_hydro_truths_skip_failed_and_non_positive_runs(small_config):
     assert draws[0][1].shape == (4,)
 
 
+@pytest.mark.slow
 def test_design_truths_without_features_draw_them_from_the_emulator(small_config):
     """A truth design alone: each trial's truth is its row's inputs and lambda_y, its features the
     emulator's draw there (so its check differs from the hydrocode truths' only by the emulator)."""

@@ -103,6 +103,7 @@ def bootstrap_and_brute_force(settings_104s):
     return boot, brute
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("column", [
     pytest.param(c, marks=pytest.mark.xfail(strict=True, reason=(
         f"{c}: bootstrap {BOOTSTRAP_BEYOND[c][0]} m/s against brute force {BOOTSTRAP_BEYOND[c][1]}, measured: "
@@ -163,12 +164,14 @@ def robust_reads(paper_config_readonly):
 CASES = [(shot, column) for shot in SHOTS for column in CALIBRATION_FEATURES]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shot, column", CASES)
 def test_record_read_spread_is_within_its_observation_sd(robust_reads, shot, column):
     shifts, observation_sd = robust_reads[shot][column]
     assert readout_sd(shifts) <= 1.5 * observation_sd
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shot, column", [
     pytest.param(shot, column, marks=pytest.mark.xfail(strict=True, reason=(
         f"{shot} {column}: mean shift {BEYOND[shot, column]:+.2f} observation sd, measured")))

@@ -158,9 +158,10 @@ def emulator_spec(config: dict, shots) -> EmulatorSpec:
     jc = model == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
     powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key] and jc)
     mappings = {s: shot_mapping(config, s) for s in shots}
+    yield_section = section.get("yield_input")    # left out of the stage's slice for a law it does not list
     yield_input = None
-    if model in section["yield_input"]["models"]:
-        yield_input = YieldInput(model, tuple(strength_parameters(config)), section["yield_input"]["strain_rate_per_s"],
+    if yield_section is not None and model in yield_section["models"]:
+        yield_input = YieldInput(model, tuple(strength_parameters(config)), yield_section["strain_rate_per_s"],
                                  config["material"]["T_ref_K"])
     return EmulatorSpec(section["structure"], mappings, prior_bounds(config), powers, emulator_settings(config),
                         yield_input=yield_input)

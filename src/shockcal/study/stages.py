@@ -21,6 +21,7 @@ from collections.abc import Iterable, Iterator
 
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
+from shockcal.study.strength import strength_model
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
@@ -101,7 +102,24 @@ def stage_config(config: dict, stages: str | Iterable[str], shot: str | None = N
     unknown = [stage for stage in stages if stage not in STAGE_KEYS]
     if unknown:
         raise ValueError(f"unknown stage {unknown[0]!r}; stages: {', '.join(STAGE_KEYS)}")
-    return config_slice(config, [path for stage in stages for path in STAGE_KEYS[stage]], shot, "+".join(stages))
+    sliced = config_slice(config, [path for stage in stages for path in STAGE_KEYS[stage]], shot, "+".join(stages))
+    if "emulate" in stages:
+        _drop_unread_yield_input(config, stages, sliced)
+    return sliced
+
+
+def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> None:
+    """The emulate stage reads `emulator.yield_input` and material.T_ref_K only for a law in
+    `emulator.yield_input.models` (`emulator_spec`): out of any other law's slice, so that adding or
+    changing them reruns none of its jobs (material.T_ref_K stays where another stage declares it)."""
+    if strength_model(config) in config["emulator"]["yield_input"]["models"]:
+        return
+    del sliced["emulator"]["yield_input"]
+    others = [path for stage in stages if stage != "emulate" for path in STAGE_KEYS[stage]]
+    if not {"material", "material.T_ref_K"} & set(others):
+        del sliced["material"]["T_ref_K"]
+        if not sliced["material"]:
+            del sliced["material"]
 
 
 def figure_config(config: dict, name: str) -> dict:
