@@ -41,6 +41,19 @@ def get_law(name: str) -> Law:
 def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
     """The user's values completed with the declared defaults; InputError naming an unknown or
     missing parameter, a non-finite value or a violated constraint."""
+    merged = _completed(law, values)
+    bad = [k for k, v in merged.items() if not np.isfinite(v)]
+    if bad:
+        raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
+    for text, holds in law.constraints:
+        if not holds(merged):
+            raise InputError(f"{law.name}: parameters violate {text}")
+    return merged
+
+
+def _completed(law: Law, values: Mapping):
+    """`values` completed with the declared defaults, by parameter name; InputError naming an unknown
+    or missing parameter."""
     unknown = [k for k in values if k not in law.names()]
     if unknown:
         raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
@@ -48,12 +61,6 @@ def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
     missing = [k for k, v in merged.items() if v is None]
     if missing:
         raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
-    bad = [k for k, v in merged.items() if not np.isfinite(v)]
-    if bad:
-        raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
-    for text, holds in law.constraints:
-        if not holds(merged):
-            raise InputError(f"{law.name}: parameters violate {text}")
     return merged
 
 
@@ -83,13 +90,8 @@ def yield_stress_MPa(law: Law, values: Mapping[str, np.ndarray], strain_rate_per
     (scalars broadcast); declared defaults fill the material constants left out. The rows are not checked
     against the law's constraints (`user_values` checks one set): this is the emulator's input map, which
     evaluates the law at every sampler point of a box whose corners meet them."""
-    unknown = [k for k in values if k not in law.names()]
-    if unknown:
-        raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
-    missing = [p.name for p in law.params if p.name not in values and p.default is None]
-    if missing:
-        raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
-    by_field = {p.field: np.asarray(values.get(p.name, p.default), dtype=float) * p.to_code for p in law.params}
+    merged = _completed(law, values)
+    by_field = {p.field: np.asarray(merged[p.name], dtype=float) * p.to_code for p in law.params}
     columns = np.broadcast_arrays(*(by_field[field] for field in law.code_type._fields))
     rate, T = strain_rate_per_s * PER_S_TO_PER_US, float(temperature_K)
     stress = np.array([law.flow_stress(law.code_type(*row), 0.0, rate, T, 0.0, 1.0)
