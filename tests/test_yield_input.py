@@ -113,7 +113,8 @@ def test_the_yield_input_lets_the_emulator_see_a_switch_in_the_yield(paper_confi
     emulator.save(tmp_path)
     loaded = Emulator.load(tmp_path)
     inputs = {k: test[k].to_numpy() for k in test.columns}
-    np.testing.assert_array_equal(loaded.predict(inputs, SHOTS)[0], emulator.predict(inputs, SHOTS)[0])
+    # loading rebuilds the Cholesky factors: another path to the same numbers, compared at the rounding floor
+    np.testing.assert_allclose(loaded.predict(inputs, SHOTS)[0], emulator.predict(inputs, SHOTS)[0], rtol=1e-10, atol=0)
 
 
 def test_only_the_listed_laws_emulate_stage_reads_the_yield_input(paper_config):
