@@ -121,3 +121,20 @@ def test_a_settled_posterior_stops_the_study_with_an_empty_wave(sequential, tmp_
             subprocess.run([sys.executable, "-m", "shockcal", *command, "--allow-empty", "--config", str(merged)],
                            cwd=REPO, check=True)
         assert pd.read_parquet(features).empty
+
+
+@pytest.mark.slow
+def test_a_shot_added_to_a_finished_study_reruns_no_wave(sequential, tmp_path):
+    """Adding a shot (design.new_shots) rewrites the training design with the shot's input columns and gives the
+    base observed features a config of their own; neither reruns a wave, a step or the base shots' features.
+    What runs is the last step's base emulator and joint posterior (they place the shot's runs), its own runs,
+    and the study's four-shot emulator and joint posterior; without the shot again, nothing."""
+    from test_new_shots import shot_overlay
+
+    results, config = sequential
+    shot = shot_overlay(tmp_path, results)
+    jobs = pending_jobs(SEQUENTIAL, config, shot, target=str(results / "posterior" / "joint.parquet"))
+    assert set(jobs) == {"observed", "wave_emulator", "wave_calibrate", "new_shot_design", "simulate[new_shot]",
+                         "features_chunk[new_shot]", "features[new_shot]", "emulator", "calibrate"}, jobs
+    assert jobs["wave_emulator"] == jobs["wave_calibrate"] == jobs["calibrate"] == 1
+    assert pending_jobs(SEQUENTIAL, config) == {}

@@ -164,8 +164,11 @@ def step_path(step, *parts):
 
 
 def wave_design_path(wave):
-    """Wave `wave`'s design: the training design for wave 0."""
-    return DESIGN if int(wave) == 0 else run_set_path(f"wave{wave}", "design.parquet")
+    """Wave `wave`'s design, as an input: the training design for wave 0, `ancient` as the training chunks
+    read it (run_set_design). It is rewritten when the workflow is read, also when a new shot adds its input
+    column, which changes no base shot's runs; a change to the base shots' rows reruns their chunks, and so
+    everything that reads their features."""
+    return ancient(DESIGN) if int(wave) == 0 else run_set_path(f"wave{wave}", "design.parquet")
 
 
 def step_features(step):

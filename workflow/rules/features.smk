@@ -78,7 +78,9 @@ rule observed_base:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(BASE_STUDY, "observed"),
-        config=BASE_CONFIG_OPTION,
+        # the base study's config file, a channel as $SHOCKCAL_CONFIG is (common.smk): none without new shots.
+        # A function of `input`, so snakemake does not track it: adding the first shot leaves this job alone.
+        config=lambda w, input: BASE_CONFIG_OPTION,
     shell:
         "shockcal observed {params.config} --out {output} > {log} 2>&1"
 
