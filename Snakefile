@@ -1,28 +1,27 @@
-# shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
+# shockcal workflow: one study's calibration (with no --configfile, the paper's: config/config.yaml).
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
 import re
 
-from shockcal.study.validate import validate_or_exit
+from shockcal.study.validate import workflow_config_or_exit
 
-CONFIGFILE = "config/config.yaml"
-
-
-configfile: CONFIGFILE
+# The study: the --configfile files given, each a complete config or an overlay naming the config it
+# overlays (`extends:`; src/shockcal/study/config_files.py), merged through their chains, snakemake's --config
+# on top; with no --configfile, the paper's study below. Then jsonschema against the package's schema
+# (src/shockcal/config.schema.yaml; defaults filled in), the cross-field rules and the design file's
+# contents; a bad config ends snakemake with its message alone, naming the file that sets the key and the key path:
+# "shockcal: error: config/quick.yaml: simulate.chunk_size: 0 is less than the minimum of 1"
+DEFAULT_CONFIGFILE = "config/config.yaml"
+workflow_config_or_exit(
+    config,
+    configfiles=list(map(str, workflow.overwrite_configfiles)),
+    overrides=workflow.config_settings.config,
+    default=DEFAULT_CONFIGFILE,
+)
 
 
 report: "workflow/report/workflow.rst"
 
-
-# jsonschema against the package's schema (src/shockcal/config.schema.yaml; defaults filled in), then
-# the cross-field rules and the design file's contents; a bad config ends snakemake with its message
-# alone, naming the file that sets the key and the key path:
-# "shockcal: error: config/quick.yaml: simulate.chunk_size: 0 is less than the minimum of 1"
-validate_or_exit(
-    config,
-    files=[CONFIGFILE, *map(str, workflow.overwrite_configfiles)],
-    overrides=workflow.config_settings.config,
-)
 
 RESULTS = config["study"]["results_dir"]
 SHOTS = list(config["shots"])

@@ -27,7 +27,7 @@ from shockcal.study.workflow import (
     write_if_changed,
 )
 
-# The merged config (configfile + --configfile + --config) that every shockcal call reads, named by
+# The merged config (the --configfile files through their `extends` chains + --config) that every shockcal call reads, named by
 # its content so a dry run with other settings never rewrites the file running jobs read. Jobs get
 # it through $SHOCKCAL_CONFIG (the default of every `shockcal --config`); it is not a rule input or
 # param: reruns follow each rule's params slice, never this file's name or mtime. A rule's `settings`

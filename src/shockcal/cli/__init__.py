@@ -33,6 +33,7 @@ STAGE_MODULES = [
     "shockcal.cli.report",
     "shockcal.cli.stage_times",
     "shockcal.cli.config_doc",
+    "shockcal.cli.init",
     "shockcal.cli.flow_stress",
     "shockcal.cli.compare_models",
     "shockcal.cli.model_predictions",

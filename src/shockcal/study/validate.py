@@ -20,6 +20,8 @@ from shockcal.errors import ConfigError, InputError, ShockcalError, number
 from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
+from shockcal.study.config_files import merge_config_files, merge_into
+from shockcal.study.config_template import check_filled
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
 from shockcal.study.simulator_rules import check_simulator
 from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
@@ -29,46 +31,20 @@ SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
 
 def load_config(path: str | Path) -> dict:
-    """Read a YAML config, fill schema defaults and reject anything invalid, naming the key."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"config file {path} does not exist")
+    """Read a study config file (through its `extends` chain, `shockcal.study.config_files`), fill schema
+    defaults and reject anything invalid, naming the file that sets the key."""
+    config, files = merge_config_files([path])
     try:
-        text = path.read_text(encoding="utf-8-sig")
-        config = yaml.safe_load(text)
-        _check_repeated_keys(yaml.compose(text, Loader=yaml.SafeLoader), path)
-    except yaml.YAMLError as exc:
-        reason = " ".join(str(exc).split())
-        raise ConfigError(f"config file {path} is not valid YAML: {reason}") from None
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"config file {path} is not UTF-8 text: {exc}") from None
-    if not isinstance(config, dict):
-        raise ConfigError(f"config file {path} must hold a mapping at the top level")
-    return validate_config(config, source=str(path))
-
-
-def _check_repeated_keys(node, path, where: str = "") -> None:
-    """A key given twice in one mapping (two `104S:` under `shots:`) is a ConfigError naming both lines:
-    YAML loaders keep the last one silently."""
-    if isinstance(node, yaml.MappingNode):
-        seen = {}
-        for key, value in node.value:
-            name = key.value if isinstance(key, yaml.ScalarNode) else None
-            if name is not None and name in seen:
-                raise ConfigError(f"config file {path}: {where}{name}: given twice (lines {seen[name]} and "
-                                  f"{key.start_mark.line + 1}); YAML would keep only the last")
-            if name is not None:
-                seen[name] = key.start_mark.line + 1
-            _check_repeated_keys(value, path, f"{where}{name}." if name is not None else where)
-    elif isinstance(node, yaml.SequenceNode):
-        for item in node.value:
-            _check_repeated_keys(item, path, where)
+        return validate_config(config, CONFIG_SOURCE)
+    except ConfigError as exc:
+        raise ConfigError(_name_source(str(exc), [str(f) for f in files], {})) from None
 
 
 def validate_config(config: dict, source: str = "config") -> dict:
     """Validate a config mapping in place (schema + semantics) and return it."""
     from jsonschema.exceptions import ValidationError
 
+    check_filled(config, source)
     _normalise_shot_names(config)
     try:
         _schema_validator().validate(config)
@@ -110,11 +86,26 @@ def _schema_validator():
     return validators.extend(Draft202012Validator, {"properties": fill_defaults, "x-rule": check_rule})(schema)
 
 
+def workflow_config_or_exit(config: dict, configfiles: list[str], overrides: dict, default: str) -> list[str]:
+    """The Snakefile's config: the study the `configfiles` (snakemake's --configfile, in order; `default`
+    when none is given) stand for, through their `extends` chains (`merge_config_files`), with snakemake's
+    --config `overrides` on top, put in place of `config`'s contents and validated (`validate_or_exit`).
+    A bad file ends snakemake with its one line. Returns the files merged, in order."""
+    try:
+        merged, files = merge_config_files(list(configfiles) or [default])
+    except ShockcalError as exc:
+        raise SystemExit(f"shockcal: error: {exc}") from None
+    config.clear()
+    config.update(merge_into(merged, overrides))
+    files = [str(path) for path in files]
+    validate_or_exit(config, files=files, overrides=overrides)
+    return files
+
+
 def validate_or_exit(config: dict, files: list[str] | None = None, overrides: dict | None = None) -> dict:
     """`validate_config` for the Snakefile: a bad config or design ends snakemake with the message alone
     (SystemExit), where an exception would print a traceback around it. `files` are the config files
-    merged into `config`, later ones overriding (the `configfile:` and then snakemake's --configfile
-    overlays), `overrides` snakemake's --config values, which override them all; the message names the
+    merged into `config`, later ones overriding (`workflow_config_or_exit`), `overrides` snakemake's --config values, which override them all; the message names the
     one that sets the key at fault (`config_source_of`)."""
     try:
         return validate_config(config, CONFIG_SOURCE)
@@ -312,7 +303,7 @@ PLASTIC_RISE_US = 0.2
 
 def expand_candidate_grid(config: dict, source: str = "config") -> None:
     """`next_shot.grid` added to `next_shot.candidates`, one named candidate per combination (null
-    candidates read as none); a grid name that is already another candidate is a ConfigError."""
+    candidates read as none; the grid's reference shot, left out, is the study's first); a grid name that is already another candidate is a ConfigError."""
     section = config.get("next_shot") or {}
     if section.get("candidates", {}) is None:
         section["candidates"] = {}
@@ -321,6 +312,8 @@ def expand_candidate_grid(config: dict, source: str = "config") -> None:
         return
     import itertools
 
+    if grid.get("shot") is None and config.get("shots"):
+        grid["shot"] = next(iter(config["shots"]))          # the study's first shot
     for flyer, target, velocity, temperature in itertools.product(grid["flyer_mm"], grid["target_mm"],
                                                                   grid["velocity_m_s"], grid["initial_temperature_K"]):
         name = f"{grid['shot']}-{flyer:g}x{target:g}mm-{velocity:g}ms-{temperature:g}K"

@@ -1,0 +1,162 @@
+"""Study config files: a complete config, or an overlay naming the config it overlays (`extends:`).
+
+A config file is COMPLETE (a study of its own: it has every top-level key the schema requires) unless it
+names the file it overlays with a top-level `extends: <path>`, relative to the overlay's own folder.
+Overlays chain (an overlay may extend an overlay) down to one complete config. Several files given
+together (snakemake's `--configfile a.yaml b.yaml`) are each resolved through their chains, in order,
+each file once at its first place; a later file without `extends` overlays the files before it. This
+module is the one place that merges config files: the Snakefile and every `shockcal --config` read a
+study through `merge_config_files`. Refused, in one line naming the file: a partial config with no
+`extends` where a study must start, an `extends` that does not exist, a cycle, and a complete config
+given after another (its shots would be merged with the other study's).
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+
+import yaml
+
+from shockcal.errors import ConfigError
+
+EXTENDS = "extends"
+
+
+def required_keys() -> list[str]:
+    """The top-level keys the schema requires: the keys a complete config holds."""
+    from shockcal.study.validate import SCHEMA_PATH
+
+    return yaml.safe_load(SCHEMA_PATH.read_text())["required"]
+
+
+def read_config_file(path: str | Path) -> dict:
+    """One config file's mapping, as written (no defaults, `extends` kept): a missing file, bad YAML, a
+    key given twice or a top level that is not a mapping is a ConfigError naming the file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"config file {path} does not exist")
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+        config = yaml.safe_load(text)
+        _check_repeated_keys(yaml.compose(text, Loader=yaml.SafeLoader), path)
+    except yaml.YAMLError as exc:
+        reason = " ".join(str(exc).split())
+        raise ConfigError(f"config file {path} is not valid YAML: {reason}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"config file {path} is not UTF-8 text: {exc}") from None
+    if not isinstance(config, dict):
+        raise ConfigError(f"config file {path} must hold a mapping at the top level")
+    return config
+
+
+def _check_repeated_keys(node, path, where: str = "") -> None:
+    """A key given twice in one mapping (two `104S:` under `shots:`) is a ConfigError naming both lines:
+    YAML loaders keep the last one silently."""
+    if isinstance(node, yaml.MappingNode):
+        seen = {}
+        for key, value in node.value:
+            name = key.value if isinstance(key, yaml.ScalarNode) else None
+            if name is not None and name in seen:
+                raise ConfigError(f"config file {path}: {where}{name}: given twice (lines {seen[name]} and "
+                                  f"{key.start_mark.line + 1}); YAML would keep only the last")
+            if name is not None:
+                seen[name] = key.start_mark.line + 1
+            _check_repeated_keys(value, path, f"{where}{name}." if name is not None else where)
+    elif isinstance(node, yaml.SequenceNode):
+        for item in node.value:
+            _check_repeated_keys(item, path, where)
+
+
+def config_chain(path: str | Path) -> list[Path]:
+    """The files a config file stands for, the complete one first and `path` last: `path`, the file its
+    `extends` names (relative to `path`'s folder), that file's, and so on. A chain that ends in a partial
+    config, an `extends` naming no file and a cycle are ConfigErrors naming the file."""
+    chain: list[Path] = []
+    path = Path(path)
+    while True:
+        if path.resolve() in [p.resolve() for p in chain]:
+            names = " -> ".join(_shown(p) for p in [*chain, path])
+            raise ConfigError(f"{_shown(chain[-1])}: {EXTENDS}: a cycle ({names}); a chain of overlays ends in a "
+                              "complete config")
+        chain.append(path)
+        parent = read_config_file(path).get(EXTENDS)
+        if parent is None:
+            check_complete(path)
+            return chain[::-1]
+        if not isinstance(parent, str) or not parent:
+            raise ConfigError(f"{_shown(path)}: {EXTENDS}: {parent!r} is not a path; give the config file this one "
+                              "overlays, relative to this file")
+        base = Path(os.path.normpath(path.parent / parent))
+        if not base.is_file():
+            raise ConfigError(f"{_shown(path)}: {EXTENDS}: {parent} does not exist (looked for {_shown(base)})")
+        path = base
+
+
+def check_complete(path: Path) -> None:
+    """A config file without `extends` is a study of its own: it holds every key the schema requires."""
+    missing = [key for key in required_keys() if key not in read_config_file(path)]
+    if missing:
+        names = ", ".join(f"`{key}`" for key in missing)
+        raise ConfigError(f"{_shown(path)}: no {names}: a study config is complete, or names the config it "
+                          f"overlays with `{EXTENDS}:`")
+
+
+def config_files(paths: list[str | Path]) -> list[Path]:
+    """The files `paths` (in order) stand for, each once, in the order they merge: the first path's chain,
+    then each later one's (files already there skipped). A later path without `extends` overlays the files
+    before it; a complete config after another is a ConfigError (two studies merged)."""
+    if not paths:
+        raise ConfigError("no config file given")
+    files: list[Path] = []
+    for index, path in enumerate(paths):
+        path = Path(path)
+        if index and read_config_file(path).get(EXTENDS) is None:
+            chain = [path]
+            present = [key for key in required_keys() if key in read_config_file(path)]
+            if len(present) == len(required_keys()) and not _listed(path, files):
+                raise ConfigError(f"{_shown(path)}: a complete study config (no `{EXTENDS}:`) given after "
+                                  f"{_shown(files[0])}; its shots and inputs would merge with that study's: give it "
+                                  f"alone, or make it an overlay with `{EXTENDS}:`")
+        else:
+            chain = config_chain(path)
+            if files and not _listed(chain[0], files):
+                raise ConfigError(f"{_shown(path)}: overlays {_shown(chain[0])}, and {_shown(files[0])} is another "
+                                  "study config; overlays given together overlay one study")
+        files += [p for p in chain if not _listed(p, files)]
+    return files
+
+
+def merge_config_files(paths: list[str | Path]) -> tuple[dict, list[Path]]:
+    """The study config `paths` stand for (`config_files`), merged as snakemake merges config files
+    (mappings key by key, any other value replaced; `extends` dropped), and the files in merge order.
+    Not validated: `shockcal.study.validate.validate_config` fills the defaults and checks it."""
+    files = config_files(paths)
+    config: dict = {}
+    for path in files:
+        overlay = read_config_file(path)
+        overlay.pop(EXTENDS, None)
+        merge_into(config, overlay)
+    return config, files
+
+
+def merge_into(config: dict, overlay: dict) -> dict:
+    """`overlay` merged into `config` in place: a mapping over a mapping key by key, any other value
+    (a list, null) replacing what was there (snakemake's `update_config`). Returns `config`."""
+    for key, value in overlay.items():
+        if isinstance(value, dict) and isinstance(config.get(key), dict):
+            merge_into(config[key], value)
+        else:
+            config[key] = copy.deepcopy(value)
+    return config
+
+
+def _listed(path: Path, files: list[Path]) -> bool:
+    return path.resolve() in [p.resolve() for p in files]
+
+
+def _shown(path: str | Path) -> str:
+    """`path` relative to the working directory when it lies inside it (snakemake makes config files absolute)."""
+    relative = os.path.relpath(path)
+    return str(path) if relative.startswith("..") else relative

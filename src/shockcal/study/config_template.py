@@ -1,0 +1,138 @@
+"""The starting config `shockcal init` writes: every key of the config schema with its default, unit and
+meaning, and the keys a study must give marked `<fill in>`.
+
+Generated from src/shockcal/config.schema.yaml through `shockcal.study.config_doc` (the source of
+docs/configuration.md), so the two cannot drift. A key with a default is written with it; a required key
+without one is the placeholder `FILL_IN`, which `check_filled` refuses in one line naming the key until it is
+replaced; an optional key without a default (a section that only some studies use, such as simulator.command)
+is written commented out. Free-form mappings (shots, inputs, observed.records) get one example entry of
+placeholders, with each placeholder key named `<shot>`, `<input>`.
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+from shockcal.errors import ConfigError
+from shockcal.study.config_doc import Key, _default, _range, _unit, _value, load_schema, schema_keys
+
+FILL_IN = "<fill in>"
+WIDTH = 110
+# the free-form mappings a new study fills in (one example entry each); the others stay empty
+FILLED_MAPPINGS = {"shots": "<shot>", "inputs": "<input>", "observed.records": "<shot>"}
+
+# the inputs' example entries: Johnson-Cook's A, B, C, n, m (the hydrocode reads stresses in Mbar) and one shot's
+# impact velocity and shear modulus (a shot names them in velocity_input and shear_modulus_inputs)
+INPUT_EXAMPLES = (("A", "Mbar", "Johnson-Cook yield stress (1 MPa = 1e-5 Mbar)"), ("B", "Mbar", "hardening modulus"),
+                  ("C", "-", "strain-rate sensitivity"), ("n", "-", "hardening exponent"),
+                  ("m", "-", "thermal-softening exponent"),
+                  ("V_<shot>", "cm/us", "the shot's impact velocity (1 cm/us = 1e4 m/s)"),
+                  ("G", "Mbar", "shear modulus (1 GPa = 0.01 Mbar)"))
+
+HEADER = """\
+# A shockcal study config, written by `shockcal init`: a complete study of its own (no `extends:`).
+# Every key of the config schema is here with its default, unit and meaning (docs/configuration.md is the
+# same list as a table). Replace each {fill} (the material, the shots, the prior box of the inputs, the
+# records), rename each <shot> and <input> to your own names, then run the study from the repository:
+#   snakemake --cores all --configfile {path}
+# Paths in this file (records, design.file) are relative to the directory snakemake runs in.
+"""
+
+
+def render_template(path_shown: str = "config.yaml", name: str = "my-study") -> str:
+    """The starting config's text; `path_shown` is the file's path in the header's snakemake line and
+    `name` the study's name (study.name; results go to results/<name>)."""
+    keys = schema_keys(load_schema())
+    by_path = {key.path: key for key in keys}
+    lines = [HEADER.format(fill=FILL_IN, path=path_shown)]
+    for key in keys:
+        if not _hidden(key):
+            lines += _key_lines(key, _commented(key, by_path), name)
+        if key.path == ("inputs",):
+            lines += [f"  {entry}: {{min: {FILL_IN}, max: {FILL_IN}, unit: {unit}}}   # {about}"
+                      for entry, unit, about in INPUT_EXAMPLES]
+    return "\n".join(lines) + "\n"
+
+
+def check_filled(config: dict, source: str = "config") -> None:
+    """A ConfigError naming the first key that still holds the placeholder `FILL_IN`, or a placeholder
+    name (`<shot>`, `V_<shot>`): a starting config from `shockcal init` not filled in yet."""
+    problem = _placeholder(config, "")
+    if problem:
+        raise ConfigError(f"{source}: {problem}")
+
+
+def _placeholder(node, where: str) -> str | None:
+    if isinstance(node, dict):
+        for key, value in node.items():
+            path = f"{where}.{key}" if where else str(key)
+            if isinstance(key, str) and "<" in key and key.endswith(">"):
+                return f"{path}: a placeholder name from `shockcal init`; give your own (a shot's or an input's)"
+            problem = _placeholder(value, path)
+            if problem:
+                return problem
+    elif isinstance(node, list):
+        return next(filter(None, (_placeholder(item, where) for item in node)), None)
+    elif node == FILL_IN:
+        return f"{where}: still {FILL_IN} (from `shockcal init`); give its value"
+    return None
+
+
+def _hidden(key: Key) -> bool:
+    """Keys inside a free-form mapping that stays empty (its default `{}` is written) or that gets the
+    named example entries of `INPUT_EXAMPLES` (inputs) are left out."""
+    for depth in range(1, len(key.path)):
+        dotted = ".".join(key.path[:depth])
+        if key.path[depth].startswith("<") and (dotted not in FILLED_MAPPINGS or dotted == "inputs"):
+            return True
+    return False
+
+
+def _commented(key: Key, by_path: dict) -> bool:
+    """Whether `key` is written commented out: it or a section holding it is optional and has no default
+    (a section only some studies use, such as simulator or next_shot.grid)."""
+    for depth in range(1, len(key.path) + 1):
+        if key.path[depth - 1].startswith("<"):
+            continue
+        node = by_path[key.path[:depth]]
+        if not node.required and "default" not in node.schema:
+            return True
+    return False
+
+
+def _key_lines(key: Key, commented: bool, name: str) -> list[str]:
+    indent = "  " * (len(key.path) - 1)
+    mark = "# " if commented else ""
+    about = _about(key)
+    description = " ".join(str(key.schema.get("description", "")).split())
+    lines = []
+    if len(key.path) == 1:
+        lines.append("")
+    lines += [f"{indent}# {line}" for line in textwrap.wrap(description, WIDTH - len(indent) - 2)]
+    label = key.path[-1]
+    if "properties" in key.schema or ".".join(key.path) in FILLED_MAPPINGS:
+        lines.append(f"{indent}{mark}{label}:" + (f"   # {about}" if about else ""))
+        return lines
+    value = _value_of(key, name)
+    lines.append(f"{indent}{mark}{label}: {value}" + (f"   # {about}" if about else ""))
+    return lines
+
+
+def _value_of(key: Key, name: str) -> str:
+    if key.path == ("study", "name"):
+        return name
+    if key.path == ("study", "results_dir"):
+        return f"results/{name}"
+    if "default" in key.schema:
+        return _value(key.schema["default"])
+    return FILL_IN
+
+
+def _about(key: Key) -> str:
+    """The inline comment: unit, range, and 'required' or the default when the value shown is not it."""
+    parts = [_unit(key), _range(key.schema)]
+    if key.required and "default" not in key.schema:
+        parts.append("required")
+    elif "default" in key.schema and key.path in (("study", "name"), ("study", "results_dir")):
+        parts.append(f"default {_default(key.schema, key.required)}")
+    return "; ".join(part for part in parts if part)
