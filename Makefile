@@ -46,10 +46,12 @@ $(INSTALLED): pyproject.toml constraints.txt
 # into results
 STUDY ?= sequential
 $(if $(filter sequential paper,$(STUDY)),,$(error STUDY=$(STUDY): sequential (the default) or paper))
-STUDY_DIR = $(if $(filter paper,$(STUDY)),results,results/sequential)
-STUDY_CONFIG = $(if $(filter paper,$(STUDY)),,--configfile config/sequential.yaml)
+# CONFIG=FILE: a study of one's own instead (`shockcal init`, docs/your_material.md), into its study.results_dir
+CONFIG ?=
+STUDY_DIR = $(if $(CONFIG),$(shell $(PY) -c 'from shockcal.study.validate import load_config; print(load_config("$(CONFIG)")["study"]["results_dir"])'),$(if $(filter paper,$(STUDY)),results,results/sequential))
+STUDY_CONFIG = $(if $(CONFIG),--configfile $(CONFIG),$(if $(filter paper,$(STUDY)),,--configfile config/sequential.yaml))
 
-study: $(INSTALLED)  ## the default study, in waves (999 hydrocode runs; STUDY=paper: the paper's design): every figure and the HTML report into results/sequential
+study: $(INSTALLED)  ## the default study, in waves (999 hydrocode runs; STUDY=paper: the paper's design; CONFIG=FILE: your own): every figure and the HTML report into results/sequential
 	$(call study,$(STUDY_DIR),all $(STUDY_CONFIG))
 
 paper: $(INSTALLED)  ## the paper's study (config/config.yaml: 1000 Latin-hypercube runs per shot, 3,300 in all): every figure and the HTML report into results

@@ -77,8 +77,8 @@ def config_chain(path: str | Path) -> list[Path]:
     path = Path(path)
     while True:
         if path.resolve() in [p.resolve() for p in chain]:
-            names = " -> ".join(_shown(p) for p in [*chain, path])
-            raise ConfigError(f"{_shown(chain[-1])}: {EXTENDS}: a cycle ({names}); a chain of overlays ends in a "
+            names = " -> ".join(shown_path(p) for p in [*chain, path])
+            raise ConfigError(f"{shown_path(chain[-1])}: {EXTENDS}: a cycle ({names}); a chain of overlays ends in a "
                               "complete config")
         chain.append(path)
         parent = read_config_file(path).get(EXTENDS)
@@ -86,11 +86,11 @@ def config_chain(path: str | Path) -> list[Path]:
             check_complete(path)
             return chain[::-1]
         if not isinstance(parent, str) or not parent:
-            raise ConfigError(f"{_shown(path)}: {EXTENDS}: {parent!r} is not a path; give the config file this one "
+            raise ConfigError(f"{shown_path(path)}: {EXTENDS}: {parent!r} is not a path; give the config file this one "
                               "overlays, relative to this file")
         base = Path(os.path.normpath(path.parent / parent))
         if not base.is_file():
-            raise ConfigError(f"{_shown(path)}: {EXTENDS}: {parent} does not exist (looked for {_shown(base)})")
+            raise ConfigError(f"{shown_path(path)}: {EXTENDS}: {parent} does not exist (looked for {shown_path(base)})")
         path = base
 
 
@@ -99,7 +99,7 @@ def check_complete(path: Path) -> None:
     missing = [key for key in required_keys() if key not in read_config_file(path)]
     if missing:
         names = ", ".join(f"`{key}`" for key in missing)
-        raise ConfigError(f"{_shown(path)}: no {names}: a study config is complete, or names the config it "
+        raise ConfigError(f"{shown_path(path)}: no {names}: a study config is complete, or names the config it "
                           f"overlays with `{EXTENDS}:`")
 
 
@@ -116,13 +116,13 @@ def config_files(paths: list[str | Path]) -> list[Path]:
             chain = [path]
             present = [key for key in required_keys() if key in read_config_file(path)]
             if len(present) == len(required_keys()) and not _listed(path, files):
-                raise ConfigError(f"{_shown(path)}: a complete study config (no `{EXTENDS}:`) given after "
-                                  f"{_shown(files[0])}; its shots and inputs would merge with that study's: give it "
+                raise ConfigError(f"{shown_path(path)}: a complete study config (no `{EXTENDS}:`) given after "
+                                  f"{shown_path(files[0])}; its shots and inputs would merge with that study's: give it "
                                   f"alone, or make it an overlay with `{EXTENDS}:`")
         else:
             chain = config_chain(path)
             if files and not _listed(chain[0], files):
-                raise ConfigError(f"{_shown(path)}: overlays {_shown(chain[0])}, and {_shown(files[0])} is another "
+                raise ConfigError(f"{shown_path(path)}: overlays {shown_path(chain[0])}, and {shown_path(files[0])} is another "
                                   "study config; overlays given together overlay one study")
         files += [p for p in chain if not _listed(p, files)]
     return files
@@ -156,7 +156,7 @@ def _listed(path: Path, files: list[Path]) -> bool:
     return path.resolve() in [p.resolve() for p in files]
 
 
-def _shown(path: str | Path) -> str:
+def shown_path(path: str | Path) -> str:
     """`path` relative to the working directory when it lies inside it (snakemake makes config files absolute)."""
     relative = os.path.relpath(path)
     return str(path) if relative.startswith("..") else relative

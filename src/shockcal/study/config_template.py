@@ -14,7 +14,7 @@ from __future__ import annotations
 import textwrap
 
 from shockcal.errors import ConfigError
-from shockcal.study.config_doc import Key, _default, _range, _unit, _value, load_schema, schema_keys
+from shockcal.study.config_doc import Key, _default, _range, _unit, load_schema, schema_keys
 
 FILL_IN = "<fill in>"
 WIDTH = 110
@@ -124,8 +124,15 @@ def _value_of(key: Key, name: str) -> str:
     if key.path == ("study", "results_dir"):
         return f"results/{name}"
     if "default" in key.schema:
-        return _value(key.schema["default"])
+        return _yaml(key.schema["default"])
     return FILL_IN
+
+
+def _yaml(value) -> str:
+    """`value` as YAML reads it back (flow style: 1.0e-07, not 1e-07, which YAML 1.1 reads as text)."""
+    import yaml
+
+    return yaml.safe_dump(value, default_flow_style=True, width=10**6).removesuffix("\n...\n").strip()
 
 
 def _about(key: Key) -> str:

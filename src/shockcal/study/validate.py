@@ -10,7 +10,6 @@ for the workflow is the repository root.
 from __future__ import annotations
 
 import difflib
-import os
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -20,9 +19,9 @@ from shockcal.errors import ConfigError, InputError, ShockcalError, number
 from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
-from shockcal.study.config_files import merge_config_files, merge_into
-from shockcal.study.config_template import check_filled
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
+from shockcal.study.config_files import merge_config_files, merge_into, shown_path
+from shockcal.study.config_template import check_filled
 from shockcal.study.simulator_rules import check_simulator
 from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
@@ -105,8 +104,8 @@ def workflow_config_or_exit(config: dict, configfiles: list[str], overrides: dic
 def validate_or_exit(config: dict, files: list[str] | None = None, overrides: dict | None = None) -> dict:
     """`validate_config` for the Snakefile: a bad config or design ends snakemake with the message alone
     (SystemExit), where an exception would print a traceback around it. `files` are the config files
-    merged into `config`, later ones overriding (`workflow_config_or_exit`), `overrides` snakemake's --config values, which override them all; the message names the
-    one that sets the key at fault (`config_source_of`)."""
+    merged into `config`, later ones overriding (`workflow_config_or_exit`), `overrides` snakemake's --config
+    values, which override them all; the message names the one that sets the key at fault (`config_source_of`)."""
     try:
         return validate_config(config, CONFIG_SOURCE)
     except ConfigError as exc:
@@ -132,10 +131,10 @@ def config_source_of(key: str, files: list[str], overrides: dict | None = None) 
     (later ones overriding) and then snakemake's --config `overrides`, the one that holds the longest part
     of its path, the later on a tie; when none holds any of it (a default), all the files joined by ' + '."""
     parts = key.split("[")[0].split(".")
-    sources = [(_shown(path), lambda path=path: yaml.safe_load(Path(path).read_text(encoding="utf-8-sig")))
+    sources = [(shown_path(path), lambda path=path: yaml.safe_load(Path(path).read_text(encoding="utf-8-sig")))
                for path in files]
     sources.append(("snakemake --config", lambda: overrides))
-    best, depth = " + ".join(map(_shown, files)), 0
+    best, depth = " + ".join(map(shown_path, files)), 0
     for name, load in sources:
         try:
             node = load()
@@ -150,12 +149,6 @@ def config_source_of(key: str, files: list[str], overrides: dict | None = None) 
         if held and held >= depth:
             best, depth = name, held
     return best
-
-
-def _shown(path: str) -> str:
-    """`path` relative to the working directory when it lies inside it (snakemake makes overlays absolute)."""
-    relative = os.path.relpath(path)
-    return path if relative.startswith("..") else relative
 
 
 def _normalise_shot_names(config: dict) -> None:
@@ -303,7 +296,8 @@ PLASTIC_RISE_US = 0.2
 
 def expand_candidate_grid(config: dict, source: str = "config") -> None:
     """`next_shot.grid` added to `next_shot.candidates`, one named candidate per combination (null
-    candidates read as none; the grid's reference shot, left out, is the study's first); a grid name that is already another candidate is a ConfigError."""
+    candidates read as none; the grid's reference shot, left out, is the study's first); a grid name that is
+    already another candidate is a ConfigError."""
     section = config.get("next_shot") or {}
     if section.get("candidates", {}) is None:
         section["candidates"] = {}
