@@ -186,10 +186,10 @@ def history_names(config) -> dict[str, str]:
 
 
 # what the builders read: the shots (names, analysis windows), the records' columns, the extractor's
-# settings, the prior box, the observation error, the figures' random stream
+# settings, the prior box and the reference sets of its law, the observation error, the figures' random stream
 _RECORDS = ("shots", "observed.records")
 _TRACE = (*_RECORDS, "features")
-_POSTERIOR = ("shots", "inputs")
+_POSTERIOR = ("shots", "inputs", "strength.model?", "study.reference_sets?")
 _FEATURE_SPACE = ("shots", "observed.sd_fraction")
 
 

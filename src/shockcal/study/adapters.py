@@ -330,7 +330,7 @@ def observed_table(config: dict) -> pd.DataFrame:
                                            stream_seed(config["study"]["seed"], "readout", shot))})
         else:
             where = f"observed.features.{shot}"
-            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
+            rows.append({"shot": shot, "source": f"published ({where})",
                          **observed["features"][shot], **dict.fromkeys(READOUT_COLUMNS, 0.0),
                          "noise_sd_m_s": float("nan"), "noise_ar_order": 0, "readout_half_window_ns": 0.0})
         box = velocity_box_m_s(config, shot)

@@ -21,6 +21,8 @@ from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
+from shockcal.study.references import check_reference_sets
+from shockcal.study.report_notes import check_report_notes
 from shockcal.study.simulator_rules import check_simulator
 from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
@@ -77,6 +79,8 @@ def validate_config(config: dict, source: str = "config") -> dict:
     apply_strength_model(config, source)
     expand_candidate_grid(config, source)
     check_semantics(config, source)
+    check_reference_sets(config, source)
+    check_report_notes(config, source)
     check_simulator(config, source)
     check_design_file(config, source)
     return config
