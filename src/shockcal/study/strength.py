@@ -51,8 +51,8 @@ def apply_strength_model(config: dict, source: str) -> None:
     shots' velocity inputs and, for a law without a G law, their shear-modulus inputs; `calibration.cube_power`
     drops Johnson-Cook's inputs the law does not have (a Johnson-Cook config's power, kept by an overlay that
     cannot delete it); a name the law has (Steinberg-Guinan's n) keeps its power. ConfigError naming the key:
-    a parameter the law does not have, a missing bound, min >= max, an input that is neither the law's nor a shot's, a box corner whose flow stress is
-    negative or not finite."""
+    a parameter the law does not have, a missing bound, min >= max, an input that is neither the law's nor a
+    shot's, a box corner whose flow stress is negative or not finite."""
     model = strength_model(config)
     if model == DEFAULT_MODEL:
         return
