@@ -22,7 +22,7 @@ from shockcal.plausibility import check_observed, check_plateau, release_times_u
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
 from shockcal.study.simulator_rules import check_simulator
-from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
+from shockcal.study.strength_config import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
