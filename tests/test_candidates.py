@@ -34,7 +34,7 @@ from shockcal.hydro import AL5083
 from shockcal.io import write_table
 from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
-from shockcal.study.strength import next_shot_targets
+from shockcal.study.strength_config import next_shot_targets
 from shockcal.study.validate import validate_config
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
 

@@ -28,7 +28,7 @@ from shockcal.study.config import (
     velocity_box_m_s,
     wave_sizes,
 )
-from shockcal.study.strength import DEFAULT_MODEL, strength_model, strength_parameters
+from shockcal.study.strength_config import DEFAULT_MODEL, strength_model, strength_parameters
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -191,7 +191,7 @@ def _figure_numbers(names: list[str]) -> str:
 
 
 def _figure_reads() -> dict[str, tuple[str, ...]]:
-    from shockcal.plots.catalogue import catalogue
+    from shockcal.study.figure_catalogue import catalogue
 
     return {name: spec.reads for name, spec in catalogue(FIGURE_SHOTS).items()}
 

@@ -21,7 +21,7 @@ from collections.abc import Iterable, Iterator
 
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
-from shockcal.study.strength import strength_model
+from shockcal.study.strength_config import strength_model
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
@@ -124,7 +124,7 @@ def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> N
 
 def figure_config(config: dict, name: str) -> dict:
     """The slice figure `name` reads: the figures stage's keys and its catalogue entry's `reads`."""
-    from shockcal.plots.catalogue import figure_spec
+    from shockcal.study.figure_catalogue import figure_spec
 
     return config_slice(config, [*STAGE_KEYS["figures"], *figure_spec(name, config).reads], label=name)
 

@@ -24,7 +24,7 @@ from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velo
 from shockcal.study.references import check_reference_sets
 from shockcal.study.report_notes import check_report_notes
 from shockcal.study.simulator_rules import check_simulator
-from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
+from shockcal.study.strength_config import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"

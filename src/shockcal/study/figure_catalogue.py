@@ -2,7 +2,8 @@
 function draws it.
 
 Importing this module is cheap (the Snakefile lists the figures from it); plotting modules are
-imported when a figure is built.
+imported when a figure is built. It lives in the study package, beside the other config readers: the
+plotting modules (`shockcal.plots`) import nothing of the study package.
 
 Inputs arrive as named files (`FigureInputs`): keys `<kind>` or `<kind>:<shot or calibration>`
 with the kinds of `INPUT_KINDS` (`observed`, `posterior:joint`, `features:104S`, ...); a key may
@@ -175,7 +176,7 @@ def _sobol(inputs, config):
 
 def _next_shot(inputs, config):
     from shockcal.plots.next_shot import next_shot_ranking
-    from shockcal.study.strength import next_shot_targets
+    from shockcal.study.strength_config import next_shot_targets
 
     return next_shot_ranking(inputs.table("next_shot_ranking"), next_shot_targets(config))
 
