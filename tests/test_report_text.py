@@ -13,7 +13,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.plots.catalogue import FigureInputs, catalogue, figure_spec, history_names
+from shockcal.study.figure_catalogue import FigureInputs, catalogue, figure_spec, history_names
+from shockcal.study.references import drawn_sets
 from shockcal.study.report_notes import caption_names
 from shockcal.study.stages import figure_config
 from shockcal.study.validate import validate_config
@@ -139,7 +140,7 @@ def test_the_papers_marginals_draw_grays_sets_at_their_values(paper_config_reado
     from shockcal.plots.posterior import fig07_marginals
 
     config = figure_config(paper_config_readonly, "fig07_marginals")
-    fig = fig07_marginals(_posteriors(config, ["joint"]), config)
+    fig = fig07_marginals(_posteriors(config, ["joint"]), config, drawn_sets(config))
     names = list(config["inputs"])
     drawn = {}
     for ax, name in zip(fig.axes[:len(names)], names):

@@ -4,13 +4,14 @@ Posterior tables hold one column per calibrated input in its declared unit, the 
 `inputs.<name>.unit` (Table IV units for Johnson-Cook; plus bookkeeping columns such as lambda_y and
 log_likelihood, which are ignored). Each is drawn in the unit a user reads (`display_columns`: MPa for
 stresses, GPa for the shots' shear-modulus inputs, m/s for velocities). Axes span the prior box in
-those units, widened where a reference value (`study.reference_sets`, `shockcal.study.references`) lies
-outside it; figure 7 draws the reference sets of the study's law as vertical lines.
+those units, widened where a value of the reference sets given lies outside it (the study's come from
+`study.reference_sets` through `shockcal.study.references.drawn_sets`, which the figure catalogue passes
+in); figure 7 draws them as vertical lines.
 """
 
 from __future__ import annotations
 
-import logging
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
@@ -20,17 +21,15 @@ from shockcal.units import unit_factor, user_columns, user_units
 
 REFERENCE_STYLES = ("-", "--", "-.", ":")   # line styles of the reference sets, in turn
 N_BINS = 40
-log = logging.getLogger(__name__)
 
 
-def _reference_lines(config: dict) -> list[tuple[str, str, dict[str, float]]]:
-    """The config's reference sets of the study's law (`study.reference_sets`), each as (legend label, line
-    style, {input: value in its display unit})."""
-    from shockcal.study.references import drawn_sets
-
+def _reference_lines(references: Sequence, config: dict) -> list[tuple[str, str, dict[str, float]]]:
+    """Reference sets (each with a `label` and `values` {input: (value, unit)}, as
+    `shockcal.study.references.ReferenceSet`), each as (legend label, line style, {input: value in its
+    display unit})."""
     columns = display_columns(config)
     lines = []
-    for i, ref in enumerate(drawn_sets(config)):
+    for i, ref in enumerate(references):
         values = {name: value * unit_factor(unit, columns[name][1]) for name, (value, unit) in ref.values.items()}
         lines.append((ref.label, REFERENCE_STYLES[i % len(REFERENCE_STYLES)], values))
     return lines
@@ -54,43 +53,39 @@ def display_label(name: str, config: dict) -> str:
     return input_label(name, display_columns(config)[name][1])
 
 
-def display_limits(name: str, config: dict) -> tuple[float, float]:
+def display_limits(name: str, config: dict, references: Sequence = ()) -> tuple[float, float]:
     """Prior box of input `name` in display units, widened to show any reference set's value outside it."""
     box = config["inputs"][name]
     lo, hi = to_display(name, [box["min"], box["max"]], config)
-    refs = [values[name] for _, _, values in _reference_lines(config) if name in values]
+    refs = [values[name] for _, _, values in _reference_lines(references, config) if name in values]
     lo, hi = min([lo, *refs]), max([hi, *refs])
     pad = 0.02 * (hi - lo)
     return lo - pad, hi + pad
 
 
-def _shade_outside_box(ax, name: str, config: dict) -> None:
+def _shade_outside_box(ax, name: str, config: dict, references: Sequence) -> None:
     """Grey shading over the parts of the axis outside the prior box."""
     box = config["inputs"][name]
     lo, hi = to_display(name, [box["min"], box["max"]], config)
-    left, right = display_limits(name, config)
+    left, right = display_limits(name, config, references)
     ax.axvspan(left, lo, color=COLORS["prior"], lw=0)
     ax.axvspan(hi, right, color=COLORS["prior"], lw=0)
 
 
-def _draw_reference_sets(ax, name: str, config: dict) -> None:
+def _draw_reference_sets(ax, name: str, config: dict, references: Sequence) -> None:
     """A vertical line per reference set that gives input `name`, labelled for the legend."""
-    for label, ls, values in _reference_lines(config):
+    for label, ls, values in _reference_lines(references, config):
         if name in values:
             ax.axvline(values[name], color=COLORS["reference"], ls=ls, lw=1.1, label=label)
 
 
 @styled
-def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
-    """Histograms of each input (columns) for each calibration (rows: shots, then joint).
+def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict, references: Sequence = ()):
+    """Histograms of each input (columns) for each calibration (rows: shots, then joint), with a vertical
+    line per value of the `references` (see `_reference_lines`; a value outside the prior box widens the axis).
 
     `posteriors` maps a calibration name to its samples; None or an empty table gives a "no data" row.
-    A reference value outside the prior box is drawn and logged.
     """
-    from shockcal.study.references import outside_box
-
-    for line in outside_box(config):
-        log.warning(line)
     names = list(config["inputs"])     # every input, in the design's order
     rows = list(posteriors)
     fig, axes = subplots(len(rows), len(names), width=1.55 * len(names), height=1.35 * len(rows) + 0.9)
@@ -107,12 +102,13 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
                         va="center", fontsize=7, color="0.5")
             else:
                 values = to_display(name, samples[name], config)
-                ax.hist(values, bins=N_BINS, range=display_limits(name, config), density=True,
-                        color=COLORS["posterior"], alpha=0.75, lw=0)
-                ax.set_xlim(display_limits(name, config))
+                limits = display_limits(name, config, references)
+                ax.hist(values, bins=N_BINS, range=limits, density=True, color=COLORS["posterior"], alpha=0.75,
+                        lw=0)
+                ax.set_xlim(limits)
                 ax.set_yticks([])
-                _shade_outside_box(ax, name, config)
-                _draw_reference_sets(ax, name, config)
+                _shade_outside_box(ax, name, config, references)
+                _draw_reference_sets(ax, name, config, references)
             if r == len(rows) - 1:
                 ax.set_xlabel(display_label(name, config))
             ax.tick_params(axis="x", labelsize=6.5)
@@ -130,8 +126,9 @@ def _density_levels(hist, masses=(0.5, 0.9)):
 
 
 @styled
-def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
-    """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it."""
+def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30, references: Sequence = ()):
+    """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it, on axes that
+    show the `references`' values (as fig07_marginals)."""
     from scipy.ndimage import gaussian_filter
 
     names = list(config["inputs"])     # every input, in the design's order
@@ -145,7 +142,7 @@ def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
         return fig
     missing = [n for n in names if n not in samples.columns]
     values = {n: to_display(n, samples[n], config) for n in names if n not in missing}
-    limits = {n: display_limits(n, config) for n in names}
+    limits = {n: display_limits(n, config, references) for n in names}
     for i, yname in enumerate(names):
         for j, xname in enumerate(names):
             ax = axes[i, j]

@@ -15,6 +15,7 @@ InputError. Each entry says which keys it `needs` for the config's shots, and th
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
 
 
 # what each input kind is (the workflow's figures.smk maps every kind to its files)
+log = logging.getLogger(__name__)
 INPUT_KINDS = {
     "observed": "the observed features (features/observed.parquet)",
     "cv": "the emulator's cross-validation table (emulator/cv.parquet)",
@@ -125,16 +127,26 @@ def _crossval(inputs, config):
     return fig06_crossval(inputs.table("cv"), _shots(config))
 
 
+def _references(config):
+    """The study's reference sets to draw (`study.reference_sets` of its law); a value outside the prior box
+    is drawn and logged, not refused."""
+    from shockcal.study.references import drawn_sets, outside_box
+
+    for line in outside_box(config):
+        log.warning(line)
+    return drawn_sets(config)
+
+
 def _marginals(inputs, config):
     from shockcal.plots.posterior import fig07_marginals
 
-    return fig07_marginals(inputs.per("posterior", [*_shots(config), "joint"]), config)
+    return fig07_marginals(inputs.per("posterior", [*_shots(config), "joint"]), config, _references(config))
 
 
 def _pairs(inputs, config):
     from shockcal.plots.posterior import fig08_pairs
 
-    return fig08_pairs(inputs.table("posterior:joint"), config)
+    return fig08_pairs(inputs.table("posterior:joint"), config, references=_references(config))
 
 
 def _features_emulator(inputs, config):

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws import get_law
-from shockcal.study.strength import DEFAULT_MODEL, strength_model
+from shockcal.study.strength_config import DEFAULT_MODEL, strength_model
 from shockcal.units import DIMENSIONLESS, unit_factor
 
 

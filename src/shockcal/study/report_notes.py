@@ -17,7 +17,7 @@ HISTORY_CAPTION = "history"
 def caption_names(config: dict) -> list[str]:
     """The captions a note can go to: every figure's (the velocity histories share `history`; the next-shot
     figure's whether or not the config has candidates) and every table's."""
-    from shockcal.plots.catalogue import catalogue, history_names
+    from shockcal.study.figure_catalogue import catalogue, history_names
 
     figures = [name for name in catalogue(config) if name not in history_names(config)]
     return [*figures, *(["next_shot"] if "next_shot" not in figures else []), HISTORY_CAPTION, *REPORT_TABLES]
