@@ -13,6 +13,7 @@ from shockcal.hydro import MaterialProperties
 from shockcal.hydro.hugoniot import cubic_from_hugoniot, hugoniot_line, hugoniot_shock_speed_km_s
 from shockcal.materials import library_entry, load_material, material_names, material_properties, resolve_material
 from shockcal.study.adapters import material_properties as config_material_properties
+from shockcal.study.stages import STAGE_KEYS, stage_config
 from shockcal.study.validate import validate_config
 
 UP_KM_S = np.linspace(0.0, 1.0, 1001)[1:]        # the particle velocities of plate impact the forms must agree on
@@ -101,8 +102,8 @@ def _with_material(config: dict, material: dict) -> dict:
 
 
 def test_config_names_a_material_and_overrides_keys(paper_config):
-    named = _with_material(paper_config, {"name": "al5083"})
-    assert named["material"] == {"name": "al5083", **paper_config["material"]}
+    named = _with_material(paper_config, {"name": "al5083", "T_melt_K": 900.0})
+    assert named["material"] == {**paper_config["material"], "T_melt_K": 900.0}
     copper = _with_material(paper_config, {"name": "copper", "T_melt_K": 1350})
     assert copper["material"]["T_melt_K"] == 1350 and copper["material"]["rho0_g_cc"] == 8.93
     assert set(copper["material"]["eos"]) == {"c1_Mbar", "c2_Mbar", "c3_Mbar", "gamma0"}   # every stage sees the cubic
@@ -171,3 +172,24 @@ def test_materials_command_lists_the_library(capsys):
     assert "c0_km_s = 3.94, s = 1.489" in shown and "c1_Mbar = 1.38626" in shown
     assert main(["materials", "brass"]) == 2
     assert "unknown material 'brass'" in capsys.readouterr().err
+
+
+# The paper's material as config/config.yaml gave it before it named the library's entry (up to 2026-11-28).
+PAPER_MATERIAL = {"rho0_g_cc": 2.668, "eos": {"c1_Mbar": 0.7797, "c2_Mbar": 0.2239, "c3_Mbar": 1.668, "gamma0": 2.13},
+                  "T_ref_K": 298.0, "T_melt_K": 893.0, "cv_J_per_kg_K": 900.0, "strain_rate_ref_per_s": 1.0}
+
+
+def test_naming_the_material_reruns_nothing(paper_config):
+    """config/config.yaml's `material: {name: al5083}` gives every stage the slice the explicit values gave
+    (the workflow's rerun keys), for every shot and next-shot candidate."""
+    assert paper_config["material"] == {"name": "al5083", **PAPER_MATERIAL}
+    explicit = _with_material(paper_config, copy.deepcopy(PAPER_MATERIAL))
+    compared = 0
+    for stage, paths in STAGE_KEYS.items():
+        per_shot = any("{shot" in path for path in paths)
+        names = [None] if not per_shot else (list(paper_config["next_shot"]["candidates"]) if stage.startswith("next_shot")
+                                              else list(paper_config["shots"]))
+        for name in names:
+            assert stage_config(paper_config, stage, name) == stage_config(explicit, stage, name), (stage, name)
+            compared += 1
+    assert compared > len(STAGE_KEYS)

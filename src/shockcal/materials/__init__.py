@@ -56,13 +56,16 @@ def resolve_material(section: Mapping, where: str = "material") -> dict:
     form than the entry's (the cubic's c1_Mbar.. against the Us-up c0_km_s, s) replaces the entry's form
     (its gamma0 stays unless given). The EOS is then converted by `shockcal.hydro.hugoniot.cubic_eos` (both
     forms at once, a partial form: an InputError naming the key). Keys of neither kind are left for the
-    caller to refuse (the schema, `material_properties`). A resolved section resolves to itself.
+    caller to refuse (the schema, `material_properties`). `name: null` names no entry (an overlay giving a
+    whole material over a named one). A resolved section resolves to itself.
 
     Args:
         section: the material section (a mapping).
         where: its name in messages ('material').
     """
     resolved = dict(section)
+    if "name" in resolved and resolved["name"] is None:      # an overlay's `name: null`: no library entry
+        del resolved["name"]
     if "name" in resolved:
         base = library_entry(resolved["name"], f"{where}.name")["material"]
         overrides = resolved
