@@ -30,8 +30,8 @@ from shockcal.campaign.candidates import (
 )
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
+from shockcal.hydro.material_library import load_material
 from shockcal.io import write_table
-from shockcal.materials import load_material
 from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
 from shockcal.study.strength import next_shot_targets

@@ -11,7 +11,13 @@ from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import MaterialProperties
 from shockcal.hydro.hugoniot import cubic_from_hugoniot, hugoniot_line, hugoniot_shock_speed_km_s
-from shockcal.materials import library_entry, load_material, material_names, material_properties, resolve_material
+from shockcal.hydro.material_library import (
+    library_entry,
+    load_material,
+    material_names,
+    material_properties,
+    resolve_material,
+)
 from shockcal.study.adapters import material_properties as config_material_properties
 from shockcal.study.stages import STAGE_KEYS, stage_config
 from shockcal.study.validate import validate_config

@@ -12,10 +12,10 @@ import pytest
 from shockcal.errors import ConfigError
 from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
 from shockcal.hydro.eos import cold_pressure
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.solver import initial_mesh
 from shockcal.hydro.state import Strength
 from shockcal.hydro.strength import thermal_factor
-from shockcal.materials import load_material
 from shockcal.study.adapters import hydro_inputs
 from shockcal.study.stages import stage_config
 from shockcal.study.validate import validate_config

@@ -18,8 +18,8 @@ from shockcal.errors import InputError
 from shockcal.hydro import Geometry, LawShotParameters, ShotParameters, run_shot
 from shockcal.hydro import shot as shot_module
 from shockcal.hydro.laws import get_law
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.state import LawStrength
-from shockcal.materials import load_material
 from shockcal.units import CM_US_TO_M_S
 
 AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library

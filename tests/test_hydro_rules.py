@@ -10,8 +10,8 @@ import pytest
 
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import Geometry, HydroSettings, LawShotParameters, MaterialProperties, ShotParameters
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.shot import run_shot
-from shockcal.materials import load_material
 from shockcal.study.validate import validate_config
 
 AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library

@@ -18,7 +18,7 @@ from shockcal.campaign.next_shot import normal_scores
 from shockcal.campaign.next_shot_check import check_summary, check_table, realized_gain, truth_design, verdict
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
-from shockcal.materials import load_material
+from shockcal.hydro.material_library import load_material
 from shockcal.study.adapters import candidate, candidate_box, input_box, shot_mapping, study_design
 from shockcal.study.config import input_names, prior_bounds
 from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config, plan_check

@@ -17,7 +17,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from shockcal.materials import library_entry, material_names, material_properties
+    from shockcal.hydro.material_library import library_entry, material_names, material_properties
 
     if not args.names:
         for name in material_names():

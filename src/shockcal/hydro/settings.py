@@ -53,8 +53,8 @@ class Geometry:
 class MaterialProperties:
     """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target;
     checked on creation (`shockcal.hydro.rules`: an InputError naming the field). From a library name or
-    the Us-up Hugoniot (c0, s, gamma0): `shockcal.materials.load_material("copper")`,
-    `shockcal.materials.material_properties(section)` (the study config's `material` rules).
+    the Us-up Hugoniot (c0, s, gamma0): `shockcal.hydro.material_library.load_material("copper")`,
+    `shockcal.hydro.material_library.material_properties(section)` (the study config's `material` rules).
 
     Args:
         rho0_g_cc: initial density (g/cc).

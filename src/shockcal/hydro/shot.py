@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.parameters import LawShotParameters, ShotParameters
 from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.solver import simulate
@@ -60,7 +61,7 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         geometry: flyer and target thickness (mm), the simulated time (us) and the plates' initial
             temperature (K; hot plates start expanded at zero pressure, `MaterialProperties.initial_state`).
         material: EOS and thermal constants of flyer and target; None: the material library's `al5083`
-            (`shockcal.materials.load_material`, the paper's Table II).
+            (`shockcal.hydro.material_library.load_material`, the paper's Table II).
         settings: mesh, output sampling, artificial viscosity and time stepping (default the study's).
 
     Returns:
@@ -69,8 +70,6 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         a result with status "failed" and a reason naming the cell and time, never an exception.
     """
     if material is None:
-        from shockcal.materials import load_material  # here: shockcal.materials imports this package
-
         material = load_material("al5083")
     nf, nt = settings.cells(geometry.flyer_mm, "Geometry.flyer_mm"), settings.cells(geometry.target_mm, "Geometry.target_mm")
     dt_out = settings.output_dt_us()

@@ -27,7 +27,7 @@ from shockcal.study.validate import load_config
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "strength.model?")
 
-# the material's constants, not its library `name` (`shockcal.materials`): a config naming its material and one
+# the material's constants, not its library `name` (`shockcal.hydro.material_library`): a config naming its material and one
 # giving the same values run the same jobs
 _MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material.T_melt_K", "material.cv_J_per_kg_K",
              "material.strain_rate_ref_per_s")

@@ -1,5 +1,6 @@
-"""A small library of materials, one data file each (`<name>.yaml` here, its sources cited in it), and the
-one resolver of a `material` section that both the study config and the library use.
+"""A small library of materials, one data file each (src/shockcal/materials/<name>.yaml, shipped with the
+package, its sources cited in it), and the one resolver of a `material` section that both the study config
+and the library use.
 
 A section names a library entry and overrides it key by key, its EOS in either form
 (`shockcal.hydro.hugoniot.cubic_eos`):
@@ -28,7 +29,7 @@ from shockcal.errors import InputError
 from shockcal.hydro.hugoniot import CUBIC_KEYS, HUGONIOT_KEYS, cubic_eos
 from shockcal.hydro.settings import MaterialProperties
 
-LIBRARY_DIR = Path(__file__).parent
+LIBRARY_DIR = Path(__file__).parents[1] / "materials"
 
 
 def material_names() -> list[str]:
