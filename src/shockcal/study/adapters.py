@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
+from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.seeds import stream_seed
 from shockcal.study.config import (
     AUTO_END_MARGIN_US,
@@ -61,10 +62,8 @@ def shot_mapping(config: dict, shot: str) -> ShotMapping:
 
 
 def material_properties(config: dict) -> MaterialProperties:
-    """`material`, its `eos` sub-section flattened."""
-    material = config["material"]
-    flat = {**{k: v for k, v in material.items() if k != "eos"}, **material["eos"]}
-    return MaterialProperties(**{f.name: float(flat[f.name]) for f in fields(MaterialProperties)})
+    """`material` (a library name, overrides, either EOS form: `shockcal.hydro.material_library.material_properties`)."""
+    return library_material_properties(config["material"])
 
 
 def hydro_settings(config: dict) -> HydroSettings:
