@@ -1,4 +1,5 @@
-# shockcal workflow: one study's calibration (with no --configfile, the paper's: config/config.yaml).
+# shockcal workflow: a calibration study of the config's material and shots (with no --configfile, the paper's:
+# config/config.yaml).
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
 import re

@@ -37,6 +37,7 @@ STAGE_MODULES = [
     "shockcal.cli.flow_stress",
     "shockcal.cli.compare_models",
     "shockcal.cli.model_predictions",
+    "shockcal.cli.materials",
 ]
 
 
