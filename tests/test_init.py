@@ -17,12 +17,12 @@ from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "copper" / "config.yaml"
-# the sections the worked example's edit fills in (docs/your_material.md)
+# the sections the worked example's edit fills in (docs/your_material.md; its material is init's --material)
 EDITED = ("material", "hydro", "shots", "inputs")
 
 
-def init(folder: Path) -> Path:
-    assert main(["init", str(folder)]) == 0
+def init(folder: Path, *options: str) -> Path:
+    assert main(["init", str(folder), *options]) == 0
     return folder / "config.yaml"
 
 
@@ -32,8 +32,8 @@ def test_every_schema_key_is_written_with_its_default(tmp_path):
     shown = 0
     for key in schema_keys(load_schema()):
         inside = [".".join(key.path[:i]) for i, part in enumerate(key.path) if part.startswith("<")]
-        if any(mapping not in FILLED_MAPPINGS or mapping == "inputs" for mapping in inside):
-            continue                      # a free-form mapping's entries: only shots' and records' are shown
+        if any(mapping not in FILLED_MAPPINGS or mapping == "inputs" for mapping in inside) or "[]" in key.name:
+            continue                      # a free-form mapping's or a list's entries: only shots' and records' are shown
         indent = "  " * (len(key.path) - 1)
         pattern = re.compile(rf"^{indent}(# )?{re.escape(key.path[-1])}:( |$)")
         written = [line for line in lines if pattern.match(line)]
@@ -72,7 +72,8 @@ def test_the_config_validates_once_its_placeholders_are_filled(tmp_path):
     path = init(tmp_path / "copper")
     path.write_text(yaml.safe_dump(filled(path, tmp_path / "records")))
     config = load_config(path)
-    assert config["study"] == {"name": "copper", "seed": 0, "results_dir": "results/copper"}
+    assert {k: config["study"][k] for k in ("name", "seed", "results_dir")} == {"name": "copper", "seed": 0,
+                                                                               "results_dir": "results/copper"}
     assert list(config["shots"]) == ["Cu300", "Cu500"] and config["calibration"]["cube_power"] == {}
 
 
@@ -96,13 +97,24 @@ def test_the_example_is_the_template_with_only_placeholder_lines_edited():
     its record's and its velocity input's lines."""
     import difflib
 
-    template = settings(render_template("studies/copper/config.yaml", "copper").splitlines())
+    template = settings(render_template("studies/copper/config.yaml", "copper", "copper").splitlines())
     example = settings(EXAMPLE.read_text().splitlines())
     diff = list(difflib.ndiff(template, example))
     removed = [line for line in diff if line.startswith("- ")]
     added = [line for line in diff if line.startswith("+ ")]
     assert removed and all(FILL_IN in line or "<shot>" in line or "window_after_arrival_us" in line for line in removed)
     assert len(added) == len(removed) + 3
+
+
+def test_a_library_material_is_named_and_its_values_shown(tmp_path, capsys):
+    path = init(tmp_path / "copper", "--material", "copper")
+    text = path.read_text()
+    assert "\n  name: copper\n" in text and "\n  # rho0_g_cc: 8.93   #" in text and "\n    # s: 1.489   #" in text
+    assert yaml.safe_load(text)["material"] == {"name": "copper"}
+    assert main(["init", str(tmp_path / "other"), "--material", "coper"]) == 2
+    assert capsys.readouterr().err.strip().endswith("--material: unknown material 'coper'; the library has al5083, "
+                                                    "copper, tantalum, ti6al4v")
+    assert not (tmp_path / "other").exists()
 
 
 def test_init_never_overwrites(tmp_path, capsys):

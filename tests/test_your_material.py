@@ -24,11 +24,12 @@ TRUTH = {"A": 90e-5, "B": 292e-5, "C": 0.025, "n": 0.31, "m": 1.09}
 
 def edit(path: Path, records: Path) -> int:
     """The worked example's edit of the init config at `path`: the sections examples/copper/config.yaml
-    fills in, its records in `records`. Returns the number of placeholders it replaced."""
+    fills in (its material is init's), its records in `records`. Returns the number of placeholders it replaced."""
     text = path.read_text()
     config = yaml.safe_load(text)
     example = yaml.safe_load((EXAMPLE / "config.yaml").read_text())
-    for section in ("material", "hydro", "shots", "inputs"):
+    assert config["material"] == example["material"] == {"name": "copper"}
+    for section in ("hydro", "shots", "inputs"):
         config[section] = example[section]
     config["observed"]["records"] = {shot: {"path": str(records / f"{shot}.txt")} for shot in example["shots"]}
     path.write_text(yaml.safe_dump(config, sort_keys=False))
@@ -39,7 +40,7 @@ def edit(path: Path, records: Path) -> int:
 @pytest.mark.slow
 def test_a_copper_study_from_init_to_the_joint_posterior_and_the_report(tmp_path):
     study = tmp_path / "copper"
-    assert main(["init", str(study)]) == 0
+    assert main(["init", str(study), "--material", "copper"]) == 0
     records = study / "records"
     subprocess.run([sys.executable, str(EXAMPLE / "make_records.py"), "--out", str(records)], cwd=REPO, check=True)
     assert edit(study / "config.yaml", records) > 0

@@ -9,10 +9,10 @@ record is written as the paper's released records are ('%' comment lines, the la
 
     python examples/copper/make_records.py --out studies/copper/records
 
-Material (cubic Mie-Grueneisen EOS from the Us-up Hugoniot Us = c0 + s up: c1 = rho0 c0^2,
-c2 = c1 (2s - 1), c3 = c1 (s - 1)(3s - 1)): Steinberg, UCRL-MA-106439 (1996), OFHC copper: rho0 8.93 g/cc,
-c0 0.394 cm/us, s 1.489, gamma0 2.02; T_melt 1356 K; cv 383 J/kg/K. Johnson-Cook parameters: Johnson &
-Cook, Eng. Fract. Mech. 21, 31 (1985), OFHC copper: A 90 MPa, B 292 MPa, n 0.31, C 0.025, m 1.09; G 46 GPa.
+Material: the library's OFHC copper (src/shockcal/materials/copper.yaml, `material: {name: copper}` in the
+study's config: Steinberg's rho0 8.93 g/cc, c0 3.94 km/s, s 1.489, gamma0 2.02; T_melt 1356 K, cv 383 J/kg/K).
+Johnson-Cook parameters: Johnson & Cook, Eng. Fract. Mech. 21, 31 (1985), OFHC copper: A 90 MPa, B 292 MPa,
+n 0.31, C 0.025, m 1.09; G 46 GPa.
 """
 
 from __future__ import annotations
@@ -23,10 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-RHO0_G_CC, C0_CM_US, S, GAMMA0 = 8.93, 0.394, 1.489, 2.02
-C1_MBAR = RHO0_G_CC * C0_CM_US**2
-COPPER = dict(rho0_g_cc=RHO0_G_CC, c1_Mbar=C1_MBAR, c2_Mbar=C1_MBAR * (2 * S - 1), c3_Mbar=C1_MBAR * (S - 1) * (3 * S - 1),
-              gamma0=GAMMA0, T_ref_K=298.0, T_melt_K=1356.0, cv_J_per_kg_K=383.0)
+MATERIAL = "copper"                           # the library's entry
 TRUTH = dict(A_MPa=90.0, B_MPa=292.0, C=0.025, n=0.31, m=1.09, shear_modulus_GPa=46.0)
 SHOTS = {"Cu300": 300.0, "Cu500": 500.0}      # shot name -> impact velocity (m/s)
 FLYER_MM, TARGET_MM, END_US = 2.0, 4.0, 2.5
@@ -46,10 +43,11 @@ def noise_model(kind: str, sd_m_s: float, dt_us: float):
 
 def make_record(velocity_m_s: float, noise: str, level: float, cell_size_um: float, rng):
     """(t_us, v_m_s) of one shot: the hydrocode's free-surface velocity plus noise of sd `level` x its peak."""
-    from shockcal.hydro import Geometry, HydroSettings, MaterialProperties, ShotParameters, run_shot
+    from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
+    from shockcal.hydro.material_library import load_material
 
     params = ShotParameters(velocity_m_s=velocity_m_s, **TRUTH)
-    run = run_shot(params, Geometry(FLYER_MM, TARGET_MM, END_US), MaterialProperties(**COPPER),
+    run = run_shot(params, Geometry(FLYER_MM, TARGET_MM, END_US), load_material(MATERIAL),
                    HydroSettings(cell_size_um=cell_size_um))
     if run.status != "ok":
         raise SystemExit(f"make_records: the {velocity_m_s:g} m/s run failed: {run.reason}")
@@ -73,7 +71,7 @@ def main(argv=None) -> int:
     rng = np.random.default_rng(args.seed)
     for shot, velocity in SHOTS.items():
         t, v = make_record(velocity, args.noise, level, args.cell_size_um, rng)
-        header = (f"%Synthetic OFHC copper record, shot {shot}: {FLYER_MM:g} mm flyer on {TARGET_MM:g} mm target at "
+        header = (f"%Synthetic record of the library's {MATERIAL}, shot {shot}: {FLYER_MM:g} mm flyer on {TARGET_MM:g} mm target at "
                   f"{velocity:g} m/s\n%shockcal hydrocode, {args.cell_size_um:g} um cells, Johnson-Cook "
                   + ", ".join(f"{k} {v:g}" for k, v in TRUTH.items())
                   + f"; {args.noise} noise, sd {level:g} of the peak, seed {args.seed}\n% time (us)  Up (m/s)\n")

@@ -5,7 +5,7 @@ from __future__ import annotations
 from shockcal.cli import add_command
 
 EXAMPLE_INIT = """\
-shockcal init studies/copper"""
+shockcal init studies/copper --material copper"""
 
 
 def register(subparsers) -> None:
@@ -14,6 +14,9 @@ def register(subparsers) -> None:
                          "meaning, the keys to fill in marked <fill in>; then snakemake --cores all --configfile DIR/config.yaml")
     p.add_argument("dir", help="the study's folder (created if needed); its config.yaml must not exist yet")
     p.add_argument("--name", help="study.name (default: the folder's name); results go to results/<name>")
+    p.add_argument("--material", help="a material of the library (`shockcal materials`): material.name is written "
+                                      "with it, the entry's values shown commented out; default: every material key "
+                                      "to fill in")
     p.set_defaults(func=run)
 
 
@@ -29,8 +32,9 @@ def run(args) -> int:
     if out.exists():
         raise InputError(f"{out} exists; init writes a new study's config only (choose another folder, or edit it)")
     name = args.name or folder.resolve().name
+    text = render_template(str(out), name, args.material)
     folder.mkdir(parents=True, exist_ok=True)
-    out.write_text(render_template(str(out), name))
+    out.write_text(text)
     logging.getLogger("shockcal.init").info("wrote %s: fill in each <fill in>, then snakemake --cores all "
                                             "--configfile %s", out, out)
     return 0

@@ -39,14 +39,26 @@ HEADER = """\
 """
 
 
-def render_template(path_shown: str = "config.yaml", name: str = "my-study") -> str:
-    """The starting config's text; `path_shown` is the file's path in the header's snakemake line and
-    `name` the study's name (study.name; results go to results/<name>)."""
+def render_template(path_shown: str = "config.yaml", name: str = "my-study", material: str | None = None) -> str:
+    """The starting config's text.
+
+    Args:
+        path_shown: the file's path, in the header's snakemake line.
+        name: the study's name (study.name; results go to results/<name>).
+        material: a material of the library (`shockcal materials`): `material.name` is written with it and
+            the section's other keys commented out with the entry's values (to override one, uncomment
+            it); None: every material key to fill in.
+    """
     keys = schema_keys(load_schema())
     by_path = {key.path: key for key in keys}
+    entry = _library_material(material)
     lines = [HEADER.format(fill=FILL_IN, path=path_shown)]
     for key in keys:
-        if not _hidden(key):
+        if _hidden(key):
+            continue
+        if entry is not None and key.path[0] == "material" and len(key.path) > 1:
+            lines += _key_lines(key, key.path != ("material", "name"), name, _entry_value(entry, key.path[1:]))
+        else:
             lines += _key_lines(key, _commented(key, by_path), name)
         if key.path == ("inputs",):
             lines += [f"  {entry}: {{min: {FILL_IN}, max: {FILL_IN}, unit: {unit}}}   # {about}"
@@ -79,8 +91,11 @@ def _placeholder(node, where: str) -> str | None:
 
 
 def _hidden(key: Key) -> bool:
-    """Keys inside a free-form mapping that stays empty (its default `{}` is written) or that gets the
-    named example entries of `INPUT_EXAMPLES` (inputs) are left out."""
+    """Keys inside a free-form mapping that stays empty (its default `{}` is written), inside a list of
+    mappings (its default `[]` is written) or inside the inputs (the named examples `INPUT_EXAMPLES`) are
+    left out."""
+    if any(part.endswith("[]") for part in key.path):
+        return True                       # a list's items (study.reference_sets): the list's default is written
     for depth in range(1, len(key.path)):
         dotted = ".".join(key.path[:depth])
         if key.path[depth].startswith("<") and (dotted not in FILLED_MAPPINGS or dotted == "inputs"):
@@ -100,7 +115,25 @@ def _commented(key: Key, by_path: dict) -> bool:
     return False
 
 
-def _key_lines(key: Key, commented: bool, name: str) -> list[str]:
+def _library_material(material: str | None) -> dict | None:
+    """The library entry's material section, with its name (an unknown name: an InputError listing them)."""
+    if material is None:
+        return None
+    from shockcal.hydro.material_library import library_entry
+
+    return {"name": material, **library_entry(material, "--material")["material"]}
+
+
+def _entry_value(entry: dict, path: tuple[str, ...]) -> str:
+    node = entry
+    for part in path:
+        if not isinstance(node, dict) or part not in node:
+            return FILL_IN
+        node = node[part]
+    return _yaml(node)
+
+
+def _key_lines(key: Key, commented: bool, name: str, value: str | None = None) -> list[str]:
     indent = "  " * (len(key.path) - 1)
     mark = "# " if commented else ""
     about = _about(key)
@@ -113,7 +146,7 @@ def _key_lines(key: Key, commented: bool, name: str) -> list[str]:
     if "properties" in key.schema or ".".join(key.path) in FILLED_MAPPINGS:
         lines.append(f"{indent}{mark}{label}:" + (f"   # {about}" if about else ""))
         return lines
-    value = _value_of(key, name)
+    value = _value_of(key, name) if value is None else value
     lines.append(f"{indent}{mark}{label}: {value}" + (f"   # {about}" if about else ""))
     return lines
 
