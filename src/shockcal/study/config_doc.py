@@ -40,9 +40,10 @@ HEADER = """\
 <!-- Generated from src/shockcal/config.schema.yaml by `shockcal config-doc --out docs/configuration.md`:
      edit the schema, not this page (tests/test_config_doc.py compares them). -->
 
-Every key of a study config (`config/config.yaml`, and overlays such as `config/quick.yaml`), from the
-JSON Schema that the Snakefile and every `shockcal` command validate a config against. `<shot>` and
-`<input>` stand for the names under `shots` and `inputs`.
+Every key of a study config (a complete one such as `config/config.yaml` or the one `shockcal init` writes,
+and overlays such as `config/quick.yaml`, which name the config they overlay with a top-level `extends:`,
+read before validation; docs/workflow.md), from the JSON Schema that the Snakefile and every `shockcal`
+command validate a config against. `<shot>` and `<input>` stand for the names under `shots` and `inputs`.
 
 - **default**: what validation fills in when the key is left out; *required*: the key must be given.
 - **unit**: the key's unit (from its name's suffix or the schema's `x-unit`); blank: a count, a name,
