@@ -12,7 +12,8 @@ import yaml
 from shockcal.cli import main
 from shockcal.errors import ConfigError
 from shockcal.study.config_doc import load_schema, schema_keys
-from shockcal.study.config_template import FILL_IN, FILLED_MAPPINGS, render_template
+from shockcal.study.config_files import FILL_IN
+from shockcal.study.config_template import FILLED_MAPPINGS, render_template
 from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]

@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from shockcal.cli import main
-from shockcal.study.config_template import FILL_IN
+from shockcal.study.config_files import FILL_IN
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "copper"

@@ -77,7 +77,7 @@ def load_schema() -> dict:
     """The study config's JSON Schema (config.schema.yaml)."""
     import yaml
 
-    from shockcal.study.validate import SCHEMA_PATH
+    from shockcal.study.config_files import SCHEMA_PATH
 
     return yaml.safe_load(SCHEMA_PATH.read_text())
 

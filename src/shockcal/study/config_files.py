@@ -8,7 +8,8 @@ each file once at its first place; a later file without `extends` overlays the f
 module is the one place that merges config files: the Snakefile and every `shockcal --config` read a
 study through `merge_config_files`. Refused, in one line naming the file: a partial config with no
 `extends` where a study must start, an `extends` that does not exist, a cycle, and a complete config
-given after another (its shots would be merged with the other study's).
+given after another (its shots would be merged with the other study's). `check_filled` refuses a value
+`shockcal init` left as its placeholder (`FILL_IN`), before the schema's check.
 """
 
 from __future__ import annotations
@@ -22,12 +23,12 @@ import yaml
 from shockcal.errors import ConfigError
 
 EXTENDS = "extends"
+SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
+FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value the study must give
 
 
 def required_keys() -> list[str]:
     """The top-level keys the schema requires: the keys a complete config holds."""
-    from shockcal.study.validate import SCHEMA_PATH
-
     return yaml.safe_load(SCHEMA_PATH.read_text())["required"]
 
 
@@ -160,3 +161,27 @@ def shown_path(path: str | Path) -> str:
     """`path` relative to the working directory when it lies inside it (snakemake makes config files absolute)."""
     relative = os.path.relpath(path)
     return str(path) if relative.startswith("..") else relative
+
+
+def check_filled(config: dict, source: str = "config") -> None:
+    """A ConfigError naming the first key that still holds the placeholder `FILL_IN`, or a placeholder
+    name (`<shot>`, `V_<shot>`): a starting config from `shockcal init` not filled in yet."""
+    problem = _placeholder(config, "")
+    if problem:
+        raise ConfigError(f"{source}: {problem}")
+
+
+def _placeholder(node, where: str) -> str | None:
+    if isinstance(node, dict):
+        for key, value in node.items():
+            path = f"{where}.{key}" if where else str(key)
+            if isinstance(key, str) and "<" in key and key.endswith(">"):
+                return f"{path}: a placeholder name from `shockcal init`; give your own (a shot's or an input's)"
+            problem = _placeholder(value, path)
+            if problem:
+                return problem
+    elif isinstance(node, list):
+        return next(filter(None, (_placeholder(item, where) for item in node)), None)
+    elif node == FILL_IN:
+        return f"{where}: still {FILL_IN} (from `shockcal init`); give its value"
+    return None

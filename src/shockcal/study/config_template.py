@@ -3,7 +3,7 @@ meaning, and the keys a study must give marked `<fill in>`.
 
 Generated from src/shockcal/config.schema.yaml through `shockcal.study.config_doc` (the source of
 docs/configuration.md), so the two cannot drift. A key with a default is written with it; a required key
-without one is the placeholder `FILL_IN`, which `check_filled` refuses in one line naming the key until it is
+without one is the placeholder `FILL_IN`, which `shockcal.study.config_files.check_filled` refuses in one line naming the key until it is
 replaced; an optional key without a default (a section that only some studies use, such as simulator.command)
 is written commented out. Free-form mappings (shots, inputs, observed.records) get one example entry of
 placeholders, with each placeholder key named `<shot>`, `<input>`.
@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import textwrap
 
-from shockcal.errors import ConfigError
 from shockcal.study.config_doc import Key, _default, _range, _unit, load_schema, schema_keys
+from shockcal.study.config_files import FILL_IN
 
-FILL_IN = "<fill in>"
 WIDTH = 110
 # the free-form mappings a new study fills in (one example entry each); the others stay empty
 FILLED_MAPPINGS = {"shots": "<shot>", "inputs": "<input>", "observed.records": "<shot>"}
@@ -64,30 +63,6 @@ def render_template(path_shown: str = "config.yaml", name: str = "my-study", mat
             lines += [f"  {entry}: {{min: {FILL_IN}, max: {FILL_IN}, unit: {unit}}}   # {about}"
                       for entry, unit, about in INPUT_EXAMPLES]
     return "\n".join(lines) + "\n"
-
-
-def check_filled(config: dict, source: str = "config") -> None:
-    """A ConfigError naming the first key that still holds the placeholder `FILL_IN`, or a placeholder
-    name (`<shot>`, `V_<shot>`): a starting config from `shockcal init` not filled in yet."""
-    problem = _placeholder(config, "")
-    if problem:
-        raise ConfigError(f"{source}: {problem}")
-
-
-def _placeholder(node, where: str) -> str | None:
-    if isinstance(node, dict):
-        for key, value in node.items():
-            path = f"{where}.{key}" if where else str(key)
-            if isinstance(key, str) and "<" in key and key.endswith(">"):
-                return f"{path}: a placeholder name from `shockcal init`; give your own (a shot's or an input's)"
-            problem = _placeholder(value, path)
-            if problem:
-                return problem
-    elif isinstance(node, list):
-        return next(filter(None, (_placeholder(item, where) for item in node)), None)
-    elif node == FILL_IN:
-        return f"{where}: still {FILL_IN} (from `shockcal init`); give its value"
-    return None
 
 
 def _hidden(key: Key) -> bool:

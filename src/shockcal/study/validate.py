@@ -21,15 +21,12 @@ from shockcal.hydro.material_library import resolve_material
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
-from shockcal.study.config_files import merge_config_files, merge_into, shown_path
-from shockcal.study.config_template import check_filled
+from shockcal.study.config_files import SCHEMA_PATH, check_filled, merge_config_files, merge_into, shown_path
 from shockcal.study.references import check_reference_sets
 from shockcal.study.report_notes import check_report_notes
 from shockcal.study.simulator_rules import check_simulator
 from shockcal.study.strength_config import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
-
-SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
 
 
 def load_config(path: str | Path) -> dict:
