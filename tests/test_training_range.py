@@ -116,6 +116,6 @@ def test_the_report_figure_is_registered_and_names_a_feature_outside(paper_confi
     observed = pd.DataFrame([{"shot": "S", **INSIDE, "v_slope1": 150.0}])
     fig = measured_against_training({"S": TRAINING.assign(status="ok")}, observed, ["S"], 0.01)
     titles = [ax.get_title() for ax in fig.axes]
-    assert titles.count("outside the training runs: the calibration stops") == 1
+    assert titles.count("outside the training runs") == 1
     assert "outside" in titles[CALIBRATION_FEATURES.index("v_slope1")]
     assert FigureInputs().table("observed") is None

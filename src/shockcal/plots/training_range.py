@@ -37,10 +37,14 @@ def measured_against_training(training: dict, observed: pd.DataFrame | None, sho
             feature_panel(ax, column, train, None, value, sd)
             if column not in ranges:
                 continue
-            for edge in ranges[column].band():
+            low, high = ranges[column].band()
+            for edge in (low, high):
                 ax.axvline(edge, color=COLORS["training"], ls="--", lw=1.0, label="accepted band")
+            shown = ax.get_xlim()
+            pad = 0.03 * (high - low)
+            ax.set_xlim(min(shown[0], low - pad), max(shown[1], high + pad))
             if value is not None and outside_training_range({shot: {column: value}}, {shot: ranges}):
-                ax.set_title("outside the training runs: the calibration stops", color=COLORS["measurement"],
+                ax.set_title("outside the training runs", color=COLORS["measurement"],
                              fontsize=8)
         axes[r, 0].set_ylabel(shot, fontsize=10, fontweight="bold")
         missing = [what for what, table in (("training runs", train), ("measurement", measured))

@@ -36,7 +36,8 @@
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time (a noisy trace: the value of a
-   least-squares line over the record's read-out window, `shockcal.velocimetry.record_noise`).
+   least-squares line over the record's read-out window, `shockcal.velocimetry.record_noise`; the slope
+   points over at most `RISE_SHARE` of the plastic rise time, `slope_half_window_us`).
 6. A noisy trace's read-out error: the spread of its features over replicates of its noise
    (`readout_replicates`, `readout_sd`), which the calibration adds to the 1% observation sd.
 """
