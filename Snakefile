@@ -1,4 +1,4 @@
-# shockcal workflow: the Walters et al. (2018) Al-5083 calibration study.
+# shockcal workflow: a calibration study of the config's material and shots (config/config.yaml: the paper's).
 # Kept cheap at the top level (on a cluster every job re-reads it): load + validate the config,
 # then include one rule file per stage. Each stage appends its finished products to ALL_TARGETS.
 import re

@@ -1,5 +1,5 @@
 """The study emulator's errors on the hydrocode-truth runs, which it never saw, measured against its own
-predictive distribution (docs/emulator.md, "Error tails"; docs/calibration.md, "Measured: hydrocode truth").
+predictive distribution (docs/emulator.md, "Error tails"; docs/calibration.md, "Hydrocode truth").
 
 Per feature: RMSE (m/s), the emulator's median sd, the share of errors inside its 90% band and the mean
 z^2 (1 when the sds are right). Then, per emulator block, the Mahalanobis distance of each run's error

@@ -32,10 +32,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.waves import relative_variance, wave_design
 from shockcal.emulator import fit_emulator, score_heldout
 from shockcal.inference.calibration import calibrate
-from shockcal.inference.predict import draw_posterior_design
 from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
 from shockcal.seeds import stream_seed
 from shockcal.study.adapters import (

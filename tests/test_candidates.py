@@ -30,13 +30,15 @@ from shockcal.campaign.candidates import (
 )
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
-from shockcal.hydro import AL5083
+from shockcal.hydro.material_library import load_material
 from shockcal.io import write_table
 from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
-from shockcal.study.strength import next_shot_targets
+from shockcal.study.strength_config import next_shot_targets
 from shockcal.study.validate import validate_config
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
+
+AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 
 REPO = Path(__file__).resolve().parents[1]
 HOT = "104S-3.95x5.965mm-204ms-700K"

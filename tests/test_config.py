@@ -108,29 +108,70 @@ def test_the_library_validates_a_config_without_snakemake():
     assert out.stdout.strip() == "[]"
 
 
-def test_hydro_settings_defaults_are_the_schemas():
-    """`HydroSettings()` (the notebook default) and a config that leaves the numerics out agree."""
-    from dataclasses import asdict
+# every library settings dataclass a config section maps to (study/adapters.py): where its fields are read
+# from (schema sections: `a.b` a sub-section, `*` a mapping's values, `#name` a schema definition), fields
+# read from a key of another name, and whether the sections' defaults are all fields of it ("whole")
+SETTINGS = [
+    ("shockcal.hydro:HydroSettings", ["hydro"], {}, True),
+    ("shockcal.hydro:Geometry", ["shots.*", "hydro"], {}, False),
+    ("shockcal.hydro:MaterialProperties", ["material", "material.eos"], {}, False),
+    ("shockcal.velocimetry.features:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
+    ("shockcal.emulator.pcgp:Settings", ["emulator"], {"seed": "study.seed"}, False),
+    ("shockcal.emulator.yield_input:YieldInput", ["emulator.yield_input"], {}, False),
+    ("shockcal.inference.sampler:SamplerSettings", ["calibration"], {}, False),
+    ("shockcal.inference.calibration:CalibrationSettings", [],
+     {"sd_fraction": "observed.sd_fraction", "check_units": "checks.observed_units",
+      "check_plateau": "checks.plateau_vs_velocity"}, False),
+    ("shockcal.simulators.command:CommandSettings", ["simulator.command"], {}, False),
+    ("shockcal.simulators.outputs:OutputSpec", ["#run_output"], {}, True),
+    ("shockcal.campaign.candidates:Candidate", ["next_shot.candidates.*", "#candidate"], {}, False),
+]
 
-    from shockcal.hydro import HydroSettings
+
+def _schema_node(schema: dict, path: str) -> dict:
+    """The schema of the config key at dotted `path` (`*`: a mapping's values, `#name`: a definition)."""
+    parts = path.split(".")
+    node = schema["definitions"][parts.pop(0)[1:]] if parts[0].startswith("#") else schema
+    for part in parts:
+        node = node["additionalProperties"] if part == "*" else node["properties"][part]
+        if "$ref" in node:
+            node = {**schema["definitions"][node["$ref"].rsplit("/", 1)[1]], **node}
+    return node
+
+
+def _library_defaults(cls) -> dict:
+    """{field: default} of a dataclass's fields that have one (a default_factory called)."""
+    from dataclasses import MISSING, fields
+
+    return {f.name: f.default if f.default_factory is MISSING else f.default_factory()
+            for f in fields(cls) if f.default is not MISSING or f.default_factory is not MISSING}
+
+
+@pytest.mark.parametrize("target, sections, renamed, whole", SETTINGS, ids=[s[0].split(":")[1] for s in SETTINGS])
+def test_library_settings_defaults_are_the_configs(target, sections, renamed, whole):
+    """A notebook's `Settings()` and a config that leaves the keys out agree: a library default that differs
+    from the schema's fails here, whichever side drifted."""
+    import importlib
+    from dataclasses import fields
+
     from shockcal.study.validate import SCHEMA_PATH
 
-    schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]["hydro"]["properties"]
-    defaults = {k: v["default"] for k, v in schema.items() if "default" in v}
-    assert {k: v for k, v in asdict(HydroSettings()).items() if k != "cell_size_um"} == defaults
-
-
-def test_extractor_settings_defaults_are_the_schemas():
-    """`ExtractorSettings()` (the notebook default) and a config that leaves the extractor out agree."""
-    from dataclasses import asdict
-
-    from shockcal.study.validate import SCHEMA_PATH
-    from shockcal.velocimetry.features import ExtractorSettings
-
-    schema = yaml.safe_load(SCHEMA_PATH.read_text())["properties"]
-    sections = [schema["features"], schema["shots"]["additionalProperties"]["properties"]["analysis"]]
-    defaults = {k: v["default"] for section in sections for k, v in section["properties"].items()}
-    assert asdict(ExtractorSettings()) == defaults
+    module, name = target.split(":")
+    cls = getattr(importlib.import_module(module), name)
+    schema = yaml.safe_load(SCHEMA_PATH.read_text())
+    keys = {f.name: f"{section}.{f.name}" for section in reversed(sections) for f in fields(cls)
+            if f.name in _schema_node(schema, section).get("properties", {})} | renamed
+    config = {field: _schema_node(schema, path) for field, path in keys.items()}
+    config_defaults = {field: node["default"] for field, node in config.items() if "default" in node}
+    library = _library_defaults(cls)
+    assert config, f"{name}: no field is a config key (a section renamed?)"
+    drift = {field: (library[field], default) for field, default in config_defaults.items()
+             if field in library and library[field] != default}
+    assert not drift, f"{name}: library default != config default: {drift}"
+    if whole:   # the sections' every default is one of the settings', and every field a config key
+        section_defaults = {k for section in sections
+                            for k, node in _schema_node(schema, section)["properties"].items() if "default" in node}
+        assert section_defaults <= set(library) and set(library) <= set(keys)
 
 
 @pytest.mark.parametrize("path, value, message", [

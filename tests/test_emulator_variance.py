@@ -30,7 +30,7 @@ def growing_noise(seed=0):
 
 def fit(sd_model, seed=1):
     X, Y = growing_noise()
-    return PCGPEmulator.fit(X, Y, np.zeros(3), np.ones(3), Settings(n_starts=1, cv_folds=5, seed=seed, sd_model=sd_model))
+    return PCGPEmulator.fit(X, Y, np.zeros(3), np.ones(3), Settings(n_starts=1, cv_folds=5, seed=seed, sd_model=sd_model, n_jobs=1))
 
 
 @pytest.fixture(scope="module")

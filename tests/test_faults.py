@@ -17,12 +17,12 @@ import pytest
 import yaml
 
 from shockcal.cli import main, parse_pairs, parse_span
+from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import latin_hypercube
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.study_emulator import Emulator, training_data
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.inference.calibration import calibrate
-from shockcal.inference.predict import draw_posterior_design
 from shockcal.inference.problem import Problem
 from shockcal.io import atomic_path, read_table, read_tables, write_table
 from shockcal.study.adapters import calibration_settings, load_study_design, shot_mapping
@@ -404,7 +404,7 @@ def _small_emulator(config, directory=None):
     x = input_map.scaled(design)
     y = np.column_stack([60 + 20 * x[:, 0], 190 + 20 * x[:, 5], 80 + 10 * x[:, 1], 180 + 15 * x[:, 5] - 5 * x[:, 3]])
     model = PCGPEmulator.fit(input_map.raw(design), y, input_map.lower, input_map.upper,
-                             Settings(n_starts=1, cv_folds=3, calibrate_sd=False))
+                             Settings(n_starts=1, cv_folds=3, calibrate_sd=False, n_jobs=1))
     emulator = Emulator("per_shot", [Block(input_map, ["104S"], design["run"].to_numpy(), model)], dict(bounds),
                         {"104S": mapping.inputs()})
     if directory is not None:

@@ -10,14 +10,17 @@ import numpy as np
 import pytest
 
 from shockcal.errors import ConfigError
-from shockcal.hydro import AL5083, Geometry, HydroSettings, ShotParameters, run_shot
+from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
 from shockcal.hydro.eos import cold_pressure
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.solver import initial_mesh
 from shockcal.hydro.state import Strength
 from shockcal.hydro.strength import thermal_factor
 from shockcal.study.adapters import hydro_inputs
 from shockcal.study.stages import stage_config
 from shockcal.study.validate import validate_config
+
+AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 
 DATA = Path(__file__).parent / "data"
 A_MBAR, M, G_MBAR = 0.0017, 1.225, 0.27          # elastic-perfectly plastic: B = C = 0, Y = A (1 - T*^m)

@@ -15,11 +15,14 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from shockcal.errors import InputError
-from shockcal.hydro import AL5083, Geometry, LawShotParameters, ShotParameters, run_shot
+from shockcal.hydro import Geometry, LawShotParameters, ShotParameters, run_shot
 from shockcal.hydro import shot as shot_module
 from shockcal.hydro.laws import get_law
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.state import LawStrength
 from shockcal.units import CM_US_TO_M_S
+
+AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 
 THIN = Geometry(flyer_mm=1.0, target_mm=1.5, end_us=0.6)
 V_104S = 204.0                                       # m/s

@@ -9,9 +9,12 @@ import numpy as np
 import pytest
 
 from shockcal.errors import ConfigError, InputError
-from shockcal.hydro import AL5083, Geometry, HydroSettings, LawShotParameters, MaterialProperties, ShotParameters
+from shockcal.hydro import Geometry, HydroSettings, LawShotParameters, MaterialProperties, ShotParameters
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.shot import run_shot
 from shockcal.study.validate import validate_config
+
+AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 
 JC_104S = dict(A_MPa=335.0, B_MPa=425.0, C=0.0335, n=0.42, m=1.225, shear_modulus_GPa=26.9)
 

@@ -15,14 +15,16 @@ from scipy import stats
 
 from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY
 from shockcal.campaign.next_shot import normal_scores
-from shockcal.campaign.next_shot_check import check_summary, check_table, realized_gain, truth_design, verdict
+from shockcal.campaign.ranking_check import check_summary, check_table, realized_gain, truth_design, verdict
 from shockcal.cli import main
 from shockcal.errors import ConfigError, InputError
-from shockcal.hydro import AL5083
+from shockcal.hydro.material_library import load_material
 from shockcal.study.adapters import candidate, candidate_box, input_box, shot_mapping, study_design
+from shockcal.study.candidate_studies import check_candidates, check_inputs, derived_study_config, plan_check
 from shockcal.study.config import input_names, prior_bounds
-from shockcal.study.next_shot_check import check_candidates, check_inputs, derived_study_config, plan_check
 from shockcal.study.validate import validate_config
+
+AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 
 REPO = Path(__file__).resolve().parents[1]
 HOT = "104S-3.95x5.965mm-204ms-700K"

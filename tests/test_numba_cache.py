@@ -91,7 +91,7 @@ def test_the_digest_covers_the_kernels_and_what_they_import():
     names = {path.relative_to(PACKAGE).as_posix() for path in kernel_files()}
     assert {"hydro/solver.py", "hydro/plastic_return.py", "hydro/laws/preston_tonks_wallace.py",
             "hydro/state.py", "units.py", "velocimetry/mixture_fit.py"} <= names
-    assert "cli/main.py" not in names and "plots/catalogue.py" not in names
+    assert "cli/main.py" not in names and "study/figure_catalogue.py" not in names
     assert len(kernel_digest()) == 12 and kernel_digest() == kernel_digest()
 
 

@@ -111,7 +111,9 @@ def test_marginals_without_posteriors_say_so(small_config, tmp_path):
 
 
 def test_gray_values_outside_the_box_widen_the_axis(paper_config):
-    lo, hi = posterior.display_limits("C", paper_config)
+    from shockcal.study.references import drawn_sets
+
+    lo, hi = posterior.display_limits("C", paper_config, drawn_sets(paper_config))
     assert hi > 0.0335 > paper_config["inputs"]["C"]["max"]
 
 

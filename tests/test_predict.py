@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from shockcal.cli import main
+from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.errors import InputError
-from shockcal.inference.predict import draw_posterior_design
 from shockcal.io import read_table, write_table
 from shockcal.study.config import input_names
 

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from shockcal.plots.catalogue import catalogue
+from shockcal.study.figure_catalogue import catalogue
 from shockcal.study.stages import STAGE_KEYS, config_slice, figure_config, stage_config
 from shockcal.study.validate import load_config
 

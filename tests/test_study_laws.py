@@ -13,7 +13,7 @@ from shockcal.errors import ConfigError
 from shockcal.hydro import LawShotParameters, ShotParameters
 from shockcal.study.adapters import emulator_spec, shot_mapping, study_design
 from shockcal.study.stages import stage_config
-from shockcal.study.strength import next_shot_targets
+from shockcal.study.strength_config import next_shot_targets
 from shockcal.study.validate import validate_config
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from shockcal.study.config import input_columns, input_user_units
-from shockcal.study.strength import apply_strength_model
+from shockcal.study.strength_config import apply_strength_model
 from shockcal.units import unit_factor, unit_name, user_columns, user_unit
 
 

@@ -23,7 +23,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from shockcal.plots.catalogue import catalogue
+from shockcal.study.figure_catalogue import catalogue
 from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]

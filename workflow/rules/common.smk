@@ -15,7 +15,7 @@ from shockcal.study.adapters import (
     shot_mapping,
     study_design,
 )
-from shockcal.study.next_shot_check import plan_check
+from shockcal.study.candidate_studies import plan_check
 from shockcal.study.config import run_cost_mm_us, wave_sizes
 from shockcal.study.simulator import simulator_kind
 from shockcal.study.stages import figure_config, stage_config

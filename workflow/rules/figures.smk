@@ -1,9 +1,9 @@
 # The paper's fifteen figures and the study's own (Sobol indices), one rule per figure, each `shockcal figures --figure NAME`
 # with its inputs passed as KEY=PATH pairs. PNG and PDF (figures.formats) under {RESULTS}/figures/;
 # the PNG goes into the report with a caption from workflow/report/. The figures, their categories
-# and the input keys each needs come from the catalogue (shockcal.plots.catalogue); this file only
+# and the input keys each needs come from the catalogue (shockcal.study.figure_catalogue); this file only
 # says which files make each kind of input.
-from shockcal.plots.catalogue import INPUT_KINDS, catalogue, history_names
+from shockcal.study.figure_catalogue import INPUT_KINDS, catalogue, history_names
 
 FIGURE_SPECS = catalogue(config)
 HISTORY_SHOTS = history_names(config)

@@ -1,7 +1,7 @@
 """Campaign: the questions a campaign asks beyond one calibration.
 
 Which shot next (`next_shot`: expected information gain on arrays; `candidates`: a candidate's design,
-its elastic-plastic split check and the ranking; `next_shot_check`: the ranking's realized check on
+its elastic-plastic split check and the ranking; `ranking_check`: the ranking's realized check on
 posterior-drawn truths), which strength law (`model_comparison`: the evidence table;
 `box_sensitivity`: log Z with the prior box halved and doubled; `release`: the release's arrival on
 a trace), and which inputs matter (`sensitivity`: Sobol indices of the emulator, SALib). Hands on

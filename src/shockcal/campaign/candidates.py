@@ -23,10 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
-from shockcal.inference.predict import draw_posterior_design
+from shockcal.inference.problem import LAMBDA_Y
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
 
 VELOCITY = "velocity_cm_us"
@@ -76,10 +77,10 @@ def candidate_design(posterior: pd.DataFrame, names: Sequence[str], candidate: C
     Returns `run`, the inputs, `lambda_y` (1 when the posterior has none), VELOCITY_FACTOR, SLOPE,
     VELOCITY (cm/us) and SHEAR_MODULUS (Mbar).
     """
-    columns = [*names, *(["lambda_y"] if "lambda_y" in posterior.columns else [])]
+    columns = [*names, *([LAMBDA_Y] if LAMBDA_Y in posterior.columns else [])]
     design = draw_posterior_design(posterior, columns, n, seed, source, bounds)
-    if "lambda_y" not in design.columns:
-        design["lambda_y"] = 1.0
+    if LAMBDA_Y not in design.columns:
+        design[LAMBDA_Y] = 1.0
     nuisance = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0]).uniform(size=(2, n))
     design[VELOCITY_FACTOR] = 1.0 + math.sqrt(3.0) * velocity_sd_fraction * (2.0 * nuisance[0] - 1.0)
     design[SLOPE] = slope_per_K[0] + (slope_per_K[1] - slope_per_K[0]) * nuisance[1]
@@ -131,7 +132,7 @@ def check_design(design: pd.DataFrame, names: Sequence[str], source: str) -> pd.
     the file and the column otherwise."""
     from shockcal.io import require_columns
 
-    needed = ["run", *names, "lambda_y", VELOCITY_FACTOR, SLOPE, VELOCITY, SHEAR_MODULUS]
+    needed = ["run", *names, LAMBDA_Y, VELOCITY_FACTOR, SLOPE, VELOCITY, SHEAR_MODULUS]
     require_columns(design, needed, source)
     for name in needed:
         if not np.all(np.isfinite(pd.to_numeric(design[name], errors="coerce").to_numpy(float))):
@@ -172,8 +173,8 @@ def score_candidate(features: pd.DataFrame, design: pd.DataFrame, feature_names:
                          "are needed for an information gain")
     table = table[ok]
     g = table[list(feature_names)].to_numpy(float)
-    sd = noise_sd(g, sd_fraction, np.asarray(readout_sd_m_s, float), table["lambda_y"].to_numpy(float))
-    names = [*parameters, "lambda_y"]
+    sd = noise_sd(g, sd_fraction, np.asarray(readout_sd_m_s, float), table[LAMBDA_Y].to_numpy(float))
+    names = [*parameters, LAMBDA_Y]
     theta = table[names].to_numpy(float)
     joint = expected_information_gain(g, sd, np.random.default_rng(seed), targets=list(targets), theta=theta,
                                       names=names)

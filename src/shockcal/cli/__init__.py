@@ -36,6 +36,7 @@ STAGE_MODULES = [
     "shockcal.cli.flow_stress",
     "shockcal.cli.compare_models",
     "shockcal.cli.model_predictions",
+    "shockcal.cli.materials",
 ]
 
 

@@ -39,8 +39,8 @@ def run(args) -> int:
     from pathlib import Path
 
     from shockcal.errors import InputError
-    from shockcal.plots.catalogue import FigureInputs, catalogue, figure_spec
     from shockcal.plots.style import save_figure
+    from shockcal.study.figure_catalogue import FigureInputs, catalogue, figure_spec
     from shockcal.study.stages import figure_config
     from shockcal.study.validate import load_config
 

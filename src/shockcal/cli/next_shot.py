@@ -134,7 +134,7 @@ def run_suggest(args) -> int:
     from shockcal.seeds import stream_seed
     from shockcal.study.config import input_names
     from shockcal.study.stages import load_stage_config
-    from shockcal.study.strength import next_shot_targets
+    from shockcal.study.strength_config import next_shot_targets
     from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     config = load_stage_config(args.config, "suggest_shot")

@@ -2,9 +2,9 @@
 next-shot ranking (docs/next_shot.md "The realized check").
 
 next-shot-check-truths draws next_shot.check.n_truths rows of the joint posterior (stream next_shot
-"check_truths") as the truths of every compared candidate (`shockcal.campaign.next_shot_check.truth_design`): the
+"check_truths") as the truths of every compared candidate (`shockcal.campaign.ranking_check.truth_design`): the
 study's inputs, lambda_y, and each candidate's velocity and shear-modulus increment as its fourth shot
-reads them (`shockcal.study.next_shot_check`). Their runs go through `shockcal simulate` and `features`,
+reads them (`shockcal.study.candidate_studies`). Their runs go through `shockcal simulate` and `features`,
 their calibrations through `shockcal calibrate-check --truth-design ... --draws-out`.
 next-shot-check-summary reads the calibrations' draws and the ranking and writes the per-truth table
 (check.csv) and the summary with the verdict (check_summary.csv). Config keys: study.seed, next_shot,
@@ -55,13 +55,14 @@ def register(subparsers) -> None:
 def run_truths(args) -> int:
     import logging
 
-    from shockcal.campaign.next_shot_check import truth_design
+    from shockcal.campaign.ranking_check import truth_design
     from shockcal.errors import InputError
+    from shockcal.inference.problem import LAMBDA_Y
     from shockcal.io import read_table, write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import candidate, material_properties
+    from shockcal.study.candidate_studies import check_inputs
     from shockcal.study.config import input_names, prior_bounds
-    from shockcal.study.next_shot_check import check_inputs
     from shockcal.study.stages import load_stage_config
 
     config = load_stage_config(args.config, "next_shot_check_truths")
@@ -79,7 +80,7 @@ def run_truths(args) -> int:
     for name, path in outputs.items():
         write_table(designs[name], path, {"table": "design", "candidate": name, "run_set": "next-shot check truths",
                                           "source": f"joint posterior draws from {args.posterior}, seed {seed}"})
-    units = {**{name: config["inputs"][name]["unit"] for name in input_names(config)}, "lambda_y": "-",
+    units = {**{name: config["inputs"][name]["unit"] for name in input_names(config)}, LAMBDA_Y: "-",
              **{velocity: "cm/us" for _, velocity, _ in candidates.values()},
              **{increment: "Mbar" for _, _, increment in candidates.values() if increment}}
     write_table(design, args.out, {"table": "design", "run_set": "next-shot check truths", "units": units,
@@ -95,11 +96,11 @@ def run_summary(args) -> int:
 
     import pandas as pd
 
-    from shockcal.campaign.next_shot_check import check_summary, check_table
+    from shockcal.campaign.ranking_check import check_summary, check_table
     from shockcal.errors import InputError
     from shockcal.io import atomic_path, read_table, require_columns
     from shockcal.study.stages import load_stage_config
-    from shockcal.study.strength import next_shot_targets
+    from shockcal.study.strength_config import next_shot_targets
 
     config = load_stage_config(args.config, "next_shot_check_summary")
     targets = next_shot_targets(config)

@@ -37,8 +37,9 @@ def register(subparsers) -> None:
 def run(args) -> int:
     import logging
 
+    from shockcal.design.posterior_draws import draw_posterior_design
     from shockcal.errors import InputError
-    from shockcal.inference.predict import draw_posterior_design
+    from shockcal.inference.problem import LAMBDA_Y
     from shockcal.io import read_table, read_table_metadata, write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.config import input_names, prior_bounds
@@ -56,7 +57,7 @@ def run(args) -> int:
         raise InputError(f"{args.posterior}: a posterior of shots {shots}; predict draws from the joint posterior of the "
                          f"config's shots {sorted(config['shots'])}")
     design = draw_posterior_design(posterior, input_names(config), n_runs, seed, source=args.posterior,
-                                   bounds=prior_bounds(config), carried=("lambda_y",))
+                                   bounds=prior_bounds(config), carried=(LAMBDA_Y,))
     units = {name: config["inputs"].get(name, {"unit": "-"})["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})

@@ -2,7 +2,9 @@
 
 `tables`: the seeded Latin hypercube over the prior box (scipy.stats.qmc), user designs checked
 against the box (`InputBox`), the per-shot mapping of a design row onto one shot's inputs
-(`ShotMapping`), and chunk fingerprints for the fan-out. Hands on a design table: an integer `run`
+(`ShotMapping`), and chunk fingerprints for the fan-out; `posterior_draws`: a design of rows drawn from
+a joint posterior (posterior predictions, later waves, next-shot candidates); `waves`: a sequential
+study's later waves. Hands on a design table: an integer `run`
 id and one column per calibration input, in the paper's Table IV units.
 """
 

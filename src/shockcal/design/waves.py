@@ -17,9 +17,9 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import extend_design
 from shockcal.errors import InputError
-from shockcal.inference.predict import draw_posterior_design
 
 CRITERIA = ("posterior_thinned", "max_variance")
 

@@ -35,11 +35,11 @@ from shockcal.io import atomic_path
 
 FORMAT_VERSION = 5                  # 5: the smooth sd model (4 had constant sd factors only, 3 no error tails)
 SD_MODELS = ("constant", "smooth")
-Z90 = 1.6449                        # half-width of a central 90% normal band, in sd
+Z90 = 1.6449                        # half-width of a central 90% normal band, in sd (z_0.95 = 1.64485 to 4 digits)
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
 SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
 PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
-log = logging.getLogger("shockcal.emulator.study_emulator")
+log = logging.getLogger("shockcal.emulator.pcgp")
 
 
 @dataclass
@@ -52,13 +52,13 @@ class Settings:
     n_starts: int = 2              # L-BFGS-B starts per GP
     max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
     seed: int = 0
-    n_jobs: int = 1                # processes for the GP fits, threads for prediction (one BLAS thread each)
+    n_jobs: int = 2                # processes for the GP fits, threads for prediction (one BLAS thread each)
     cv_folds: int = 10             # K-fold of the sd calibration
     calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
     cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
     switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
     error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
-    sd_model: str = "constant"     # sd calibration: constant factors per output, or smooth over the box
+    sd_model: str = "smooth"       # sd calibration: smooth over the box, or constant factors per output
 
     def __post_init__(self):
         if self.sd_model not in SD_MODELS:

@@ -2,13 +2,15 @@
 
 `run_shot(params, geometry, material, settings)` simulates one shot for one set of inputs and
 returns the target's free-surface velocity history with diagnostics; the inputs are in user units
-(`ShotParameters`, `Geometry`, `MaterialProperties` with `AL5083`, `HydroSettings`). This package
-is the ground floor: it imports nothing of the study (config, design, features). See docs/hydro.md.
+(`ShotParameters`, `Geometry`, `MaterialProperties`, `HydroSettings`; a library material by name,
+`load_material("copper")`, docs/materials.md). This package is the ground floor: it imports nothing of
+the study (config, design, features). See docs/hydro.md.
 """
 
+from shockcal.hydro.material_library import load_material, material_properties
 from shockcal.hydro.parameters import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters, TableIV
-from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
+from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.shot import RunResult, run_shot
 
-__all__ = ["AL5083", "JOHNSON_COOK_INPUTS", "Geometry", "HydroSettings", "LawShotParameters", "MaterialProperties",
-           "RunResult", "ShotParameters", "TableIV", "run_shot"]
+__all__ = ["JOHNSON_COOK_INPUTS", "Geometry", "HydroSettings", "LawShotParameters", "MaterialProperties",
+           "RunResult", "ShotParameters", "TableIV", "load_material", "material_properties", "run_shot"]

@@ -52,7 +52,9 @@ class Geometry:
 @dataclass(frozen=True)
 class MaterialProperties:
     """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target;
-    checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
+    checked on creation (`shockcal.hydro.rules`: an InputError naming the field). From a library name or
+    the Us-up Hugoniot (c0, s, gamma0): `shockcal.hydro.material_library.load_material("copper")`,
+    `shockcal.hydro.material_library.material_properties(section)` (the study config's `material` rules).
 
     Args:
         rho0_g_cc: initial density (g/cc).
@@ -110,11 +112,6 @@ class MaterialProperties:
         c_sq = bulk_sound_speed_sq(mu0, 0.0, 1.0, self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar,
                                    self.gamma0)
         return math.sqrt(c_sq) * CM_US_TO_M_S
-
-
-# Al-5083-H131, the paper's Table II (Walters et al. 2018); T_melt from SPEC section 2 (not in the paper).
-AL5083 = MaterialProperties(rho0_g_cc=2.668, c1_Mbar=0.7797, c2_Mbar=0.2239, c3_Mbar=1.668, gamma0=2.13,
-                            T_ref_K=298.0, T_melt_K=893.0, cv_J_per_kg_K=900.0)
 
 
 @dataclass(frozen=True)

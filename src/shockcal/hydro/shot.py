@@ -16,8 +16,9 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.parameters import LawShotParameters, ShotParameters
-from shockcal.hydro.settings import AL5083, Geometry, HydroSettings, MaterialProperties
+from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.solver import simulate
 from shockcal.hydro.state import FAILURE_REASONS, STATUS_OK, LawStrength, Strength
 from shockcal.units import CM_US_TO_M_S, UM_TO_CM
@@ -50,7 +51,7 @@ class RunResult:
 STUDY_NUMERICS = HydroSettings()
 
 
-def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties = AL5083,
+def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties | None = None,
              settings: HydroSettings = STUDY_NUMERICS) -> RunResult:
     """Simulate one symmetric shot to `geometry.end_us` (or its end after the free surface's rise).
 
@@ -59,7 +60,8 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
             or any strength law's (`LawShotParameters`).
         geometry: flyer and target thickness (mm), the simulated time (us) and the plates' initial
             temperature (K; hot plates start expanded at zero pressure, `MaterialProperties.initial_state`).
-        material: EOS and thermal constants of flyer and target (default Al-5083, the paper's Table II).
+        material: EOS and thermal constants of flyer and target; None: the material library's `al5083`
+            (`shockcal.hydro.material_library.load_material`, the paper's Table II).
         settings: mesh, output sampling, artificial viscosity and time stepping (default the study's).
 
     Returns:
@@ -67,6 +69,8 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         the impact's kinetic energy, the plates' initial internal energy left out). A numerical failure is
         a result with status "failed" and a reason naming the cell and time, never an exception.
     """
+    if material is None:
+        material = load_material("al5083")
     nf, nt = settings.cells(geometry.flyer_mm, "Geometry.flyer_mm"), settings.cells(geometry.target_mm, "Geometry.target_mm")
     dt_out = settings.output_dt_us()
     t_out = np.arange(int(round(geometry.end_us / dt_out)) + 1) * dt_out

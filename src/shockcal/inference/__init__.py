@@ -4,7 +4,7 @@
 emulator), `sampler` (nested sampling with nautilus into a `Posterior`, with log Z and its sd),
 `summaries` (weighted quantiles and their Monte Carlo errors), `calibration` (a study's shots
 against its emulator), `coverage` (synthetic-truth checks), `inference_data` (a `Posterior` as
-ArviZ InferenceData), `predict` (posterior draws as a design, emulator predictions at a design),
+ArviZ InferenceData), `predict` (emulator predictions at a design),
 `posterior_files` (a `Posterior` written and read back) and `study_results` (`load_study`: a finished
 study's posteriors, emulator and measured features).
 Hands on posteriors (draws, weighted draws, summaries, netCDF) to predictions, figures and the campaign.

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
-from shockcal.inference.problem import Problem
+from shockcal.inference.problem import LAMBDA_Y, Problem
 from shockcal.inference.sampler import Posterior, SamplerSettings, sample
 from shockcal.inference.training_range import check_training_range
 from shockcal.plausibility import check_observed_table, check_plateau
@@ -81,7 +81,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
         check_training_range(measured, {shot: emulator.training_features(shot) for shot in shots}, source,
                              settings.check_training_range)
     posterior = sample(problem, settings.sampler, other_powers="ignore")
-    units = {**{k: settings.units.get(k, "-") for k in problem.names}, "lambda_y": "-"}
+    units = {**{k: settings.units.get(k, "-") for k in problem.names}, LAMBDA_Y: "-"}
     posterior.units = units
     posterior.user_units = {k: settings.user_units.get(k, unit) for k, unit in units.items()}
     posterior.context.update(shots=list(shots), parameters=problem.names, units=units, user_units=posterior.user_units,

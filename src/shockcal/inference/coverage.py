@@ -13,11 +13,11 @@ from scipy import stats
 
 from shockcal.errors import InputError, ShockcalError
 from shockcal.inference.calibration import CalibrationSettings, calibrate
-from shockcal.inference.problem import LAMBDA_Y_PRIOR, Problem, log_density, prior_box
+from shockcal.inference.problem import LAMBDA_Y, LAMBDA_Y_PRIOR, Problem, log_density, prior_box
 from shockcal.progress import progress
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
-log = logging.getLogger("shockcal.inference.calibration")
+log = logging.getLogger("shockcal.inference.coverage")
 
 
 def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed: int, truths=None,
@@ -62,7 +62,7 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
         except ShockcalError as error:     # recorded and left out of the coverage, never the end of the batch
             log.warning("synthetic trial %d failed: %s", trial, error)
             rows += [{"trial": trial, "parameter": name, "status": "failed", "reason": str(error)}
-                     for name in [*names, "lambda_y"]]
+                     for name in [*names, LAMBDA_Y]]
         log.debug("synthetic trial %d done (%d of %d)", trial, done, len(trial_ids))   # progress: count, time left
     table = pd.DataFrame(rows, columns=CHECK_COLUMNS)
     table["inside"] = table["inside"].astype("boolean")
@@ -92,9 +92,9 @@ def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rn
         draws.append(draws_table.assign(trial=trial, run=run))
     problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)
     truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
-    mass = hpd_mass(log_density(draws_table["log_likelihood"], draws_table["lambda_y"]), log_density(truth_ll, lam))
+    mass = hpd_mass(log_density(draws_table["log_likelihood"], draws_table[LAMBDA_Y]), log_density(truth_ll, lam))
     rows = []
-    for name, truth in [*zip(names, theta), ("lambda_y", lam)]:
+    for name, truth in [*zip(names, theta), (LAMBDA_Y, lam)]:
         q05, q95 = summary.loc[name, ["q05", "q95"]]
         rows.append({"trial": trial, "run": run, "parameter": name, "truth": truth, "q05": q05, "q95": q95,
                      "sd": summary.loc[name, "sd"], "inside": bool(q05 <= truth <= q95), "ess": summary.loc[name, "ess"],
@@ -193,7 +193,7 @@ class HydroTruths:
         if self.features is not None:
             log.info("hydrocode truth: %d of %d runs usable (every shot ok, features positive)", len(usable),
                      len(self.design))
-        lam = usable["lambda_y"].to_numpy(float) if "lambda_y" in usable else [None] * len(usable)
+        lam = usable[LAMBDA_Y].to_numpy(float) if LAMBDA_Y in usable else [None] * len(usable)
         features = usable[columns].to_numpy(float) if columns else [None] * len(usable)
         return [Truth(*row) for row in zip(usable[names].to_numpy(float), features, usable.index.to_numpy(int).tolist(),
                                            lam)]

@@ -46,6 +46,7 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
+from shockcal.inference.problem import LAMBDA_Y
 from shockcal.io import atomic_path
 from shockcal.units import user_columns
 from shockcal.velocimetry.features import CALIBRATION_FEATURES
@@ -112,7 +113,7 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
     missing = [c for c in [*names, "log_likelihood"] if c not in draws.columns]
     if missing:
         raise InputError(f"posterior draws: columns {missing} missing (columns: {list(draws.columns)})")
-    inputs = [n for n in names if n != "lambda_y"]
+    inputs = [n for n in names if n != LAMBDA_Y]
     unboxed = [n for n in inputs if n not in lower or n not in upper]
     if unboxed:
         raise InputError(f"posterior draws: no prior box for inputs {unboxed}")

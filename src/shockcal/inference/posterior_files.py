@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from shockcal.errors import InputError
+from shockcal.inference.problem import LAMBDA_Y
 from shockcal.inference.sampler import Posterior, SamplerSettings, WeightedDraws
 from shockcal.io import read_table, read_table_metadata, write_table
 
@@ -63,7 +64,7 @@ def read_posterior(path) -> Posterior:
     missing = [key for key in NEEDED_METADATA if key not in meta]
     if missing:
         raise InputError(f"{path}: not a posterior written by `shockcal calibrate` (metadata {missing} missing)")
-    names = [*meta["parameters"], "lambda_y"]
+    names = [*meta["parameters"], LAMBDA_Y]
     weighted_path = companion_path(path, "weighted")
     if not weighted_path.is_file():
         raise InputError(f"{weighted_path}: missing; the weighted draws of {path} are written beside it by "

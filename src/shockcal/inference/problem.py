@@ -27,6 +27,7 @@ from shockcal.emulator.error_model import ErrorModel
 from shockcal.errors import InputError
 from shockcal.plausibility import outside_box
 
+LAMBDA_Y = "lambda_y"          # the observation-precision scale: its column in draws, designs and summaries
 LAMBDA_Y_PRIOR = (5.0, 5.0)   # Gamma(shape, rate) of the observation-precision scale
 
 
@@ -140,7 +141,7 @@ class Problem:
             value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_var)
         bad = ~np.isfinite(value)
         if bad.any():
-            point = dict(zip([*self.names, "lambda_y"], points[np.argmax(bad)].tolist()))
+            point = dict(zip([*self.names, LAMBDA_Y], points[np.argmax(bad)].tolist()))
             raise InputError(f"{self.label}: the log-likelihood is not finite at {point} "
                              "(the emulator's prediction or covariance is invalid there)")
         return value

@@ -28,6 +28,7 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
+from shockcal.inference.problem import LAMBDA_Y
 from shockcal.inference.summaries import summarize
 from shockcal.progress import Every
 from shockcal.seeds import stream_seed
@@ -315,7 +316,7 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
                           settings.max_evaluations)
             for r in range(settings.replicates)]
     weighted = runs[0] if len(runs) == 1 else pool(runs)
-    names = [*problem.names, "lambda_y"]
+    names = [*problem.names, LAMBDA_Y]
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     draws = pd.DataFrame(weighted.points[rows], columns=names)
     draws["log_likelihood"] = weighted.log_likelihood[rows]

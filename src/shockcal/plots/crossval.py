@@ -12,8 +12,6 @@ import pandas as pd
 
 from shockcal.plots.style import CALIBRATION_FEATURES, COLORS, feature_label, no_data, note, styled, subplots
 
-CV_COLUMNS = ("shot", "feature", "simulated", "predicted")
-
 
 @styled
 def fig06_crossval(cv: pd.DataFrame | None, shots: list[str]):

@@ -1,36 +1,38 @@
-"""Posterior figures: 7 (marginals per calibration, rows, with Gray et al.'s sets) and 8 (joint pairs).
+"""Posterior figures: 7 (marginals per calibration, rows, with the config's reference sets) and 8 (joint pairs).
 
 Posterior tables hold one column per calibrated input in its declared unit, the config's
 `inputs.<name>.unit` (Table IV units for Johnson-Cook; plus bookkeeping columns such as lambda_y and
 log_likelihood, which are ignored). Each is drawn in the unit a user reads (`display_columns`: MPa for
 stresses, GPa for the shots' shear-modulus inputs, m/s for velocities). Axes span the prior box in
-those units, widened where a reference value lies outside it.
+those units, widened where a value of the reference sets given lies outside it (the study's come from
+`study.reference_sets` through `shockcal.study.references.drawn_sets`, which the figure catalogue passes
+in); figure 7 draws them as vertical lines.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pandas as pd
 
-from shockcal.hydro import JOHNSON_COOK_INPUTS
 from shockcal.plots.style import COLORS, figure_legend, input_label, no_data, styled, subplots
-from shockcal.units import user_columns, user_units
+from shockcal.units import unit_factor, user_columns, user_units
 
-# Gray et al. Johnson-Cook fits for Al-5083 (SPEC section 3), display units (A, B in MPa).
-GRAY_SETS = {
-    "all rates, all T": {"A": 210.0, "B": 620.0, "C": 0.0125, "n": 0.375, "m": 1.525},
-    "high rate, all T": {"A": 200.0, "B": 600.0, "C": 0.0200, "n": 0.380, "m": 1.500},
-    "all rates, T > RT": {"A": 270.0, "B": 470.0, "C": 0.0105, "n": 0.600, "m": 1.200},
-    "high rate, T > RT": {"A": 170.0, "B": 425.0, "C": 0.0335, "n": 0.420, "m": 1.225},
-}
-GRAY_STYLES = ("-", "--", "-.", ":")
+REFERENCE_STYLES = ("-", "--", "-.", ":")   # line styles of the reference sets, in turn
 N_BINS = 40
 
 
-def _gray_sets(config: dict) -> dict:
-    """Gray et al.'s sets when the study calibrates Johnson-Cook (its A, B, C, n, m are inputs), else none:
-    another law's `n` is not Johnson-Cook's."""
-    return GRAY_SETS if set(JOHNSON_COOK_INPUTS) <= set(config["inputs"]) else {}
+def _reference_lines(references: Sequence, config: dict) -> list[tuple[str, str, dict[str, float]]]:
+    """Reference sets (each with a `label` and `values` {input: (value, unit)}, as
+    `shockcal.study.references.ReferenceSet`), each as (legend label, line style, {input: value in its
+    display unit})."""
+    columns = display_columns(config)
+    lines = []
+    for i, ref in enumerate(references):
+        values = {name: value * unit_factor(unit, columns[name][1]) for name, (value, unit) in ref.values.items()}
+        lines.append((ref.label, REFERENCE_STYLES[i % len(REFERENCE_STYLES)], values))
+    return lines
 
 
 def display_columns(config: dict) -> dict[str, tuple[str, str, float]]:
@@ -51,34 +53,36 @@ def display_label(name: str, config: dict) -> str:
     return input_label(name, display_columns(config)[name][1])
 
 
-def display_limits(name: str, config: dict) -> tuple[float, float]:
-    """Prior box of input `name` in display units, widened to show any of Gray's values outside it."""
+def display_limits(name: str, config: dict, references: Sequence = ()) -> tuple[float, float]:
+    """Prior box of input `name` in display units, widened to show any reference set's value outside it."""
     box = config["inputs"][name]
     lo, hi = to_display(name, [box["min"], box["max"]], config)
-    refs = [s[name] for s in _gray_sets(config).values() if name in s]
+    refs = [values[name] for _, _, values in _reference_lines(references, config) if name in values]
     lo, hi = min([lo, *refs]), max([hi, *refs])
     pad = 0.02 * (hi - lo)
     return lo - pad, hi + pad
 
 
-def _shade_outside_box(ax, name: str, config: dict) -> None:
+def _shade_outside_box(ax, name: str, config: dict, references: Sequence) -> None:
     """Grey shading over the parts of the axis outside the prior box."""
     box = config["inputs"][name]
     lo, hi = to_display(name, [box["min"], box["max"]], config)
-    left, right = display_limits(name, config)
+    left, right = display_limits(name, config, references)
     ax.axvspan(left, lo, color=COLORS["prior"], lw=0)
     ax.axvspan(hi, right, color=COLORS["prior"], lw=0)
 
 
-def _gray_lines(ax, name: str, config: dict) -> None:
-    for (label, values), ls in zip(_gray_sets(config).items(), GRAY_STYLES):
+def _draw_reference_sets(ax, name: str, config: dict, references: Sequence) -> None:
+    """A vertical line per reference set that gives input `name`, labelled for the legend."""
+    for label, ls, values in _reference_lines(references, config):
         if name in values:
-            ax.axvline(values[name], color=COLORS["reference"], ls=ls, lw=1.1, label=f"Gray et al.: {label}")
+            ax.axvline(values[name], color=COLORS["reference"], ls=ls, lw=1.1, label=label)
 
 
 @styled
-def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
-    """Histograms of each input (columns) for each calibration (rows: shots, then joint).
+def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict, references: Sequence = ()):
+    """Histograms of each input (columns) for each calibration (rows: shots, then joint), with a vertical
+    line per value of the `references` (see `_reference_lines`; a value outside the prior box widens the axis).
 
     `posteriors` maps a calibration name to its samples; None or an empty table gives a "no data" row.
     """
@@ -98,12 +102,13 @@ def fig07_marginals(posteriors: dict[str, pd.DataFrame | None], config: dict):
                         va="center", fontsize=7, color="0.5")
             else:
                 values = to_display(name, samples[name], config)
-                ax.hist(values, bins=N_BINS, range=display_limits(name, config), density=True,
-                        color=COLORS["posterior"], alpha=0.75, lw=0)
-                ax.set_xlim(display_limits(name, config))
+                limits = display_limits(name, config, references)
+                ax.hist(values, bins=N_BINS, range=limits, density=True, color=COLORS["posterior"], alpha=0.75,
+                        lw=0)
+                ax.set_xlim(limits)
                 ax.set_yticks([])
-                _shade_outside_box(ax, name, config)
-                _gray_lines(ax, name, config)
+                _shade_outside_box(ax, name, config, references)
+                _draw_reference_sets(ax, name, config, references)
             if r == len(rows) - 1:
                 ax.set_xlabel(display_label(name, config))
             ax.tick_params(axis="x", labelsize=6.5)
@@ -121,8 +126,9 @@ def _density_levels(hist, masses=(0.5, 0.9)):
 
 
 @styled
-def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
-    """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it."""
+def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30, references: Sequence = ()):
+    """Joint posterior: marginal densities on the diagonal, 50% and 90% contours below it, on axes that
+    show the `references`' values (as fig07_marginals)."""
     from scipy.ndimage import gaussian_filter
 
     names = list(config["inputs"])     # every input, in the design's order
@@ -136,7 +142,7 @@ def fig08_pairs(samples: pd.DataFrame | None, config: dict, bins: int = 30):
         return fig
     missing = [n for n in names if n not in samples.columns]
     values = {n: to_display(n, samples[n], config) for n in names if n not in missing}
-    limits = {n: display_limits(n, config) for n in names}
+    limits = {n: display_limits(n, config, references) for n in names}
     for i, yname in enumerate(names):
         for j, xname in enumerate(names):
             ax = axes[i, j]

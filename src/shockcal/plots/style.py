@@ -2,7 +2,7 @@
 
 Colours mean the same thing in every figure: grey for training runs (the design), blue for the
 posterior (samples and posterior predictions), red for the measurement, orange for the emulator
-or toy model, green for reference values (Gray et al.'s Johnson-Cook sets); purple and orange
+or toy model, green for reference values (the config's `study.reference_sets`); purple and orange
 for the early and late mixture components of the feature extractor.
 
 Display units (what a shock physicist reads): A and B in MPa, shear moduli in GPa, impact

@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from shockcal.emulator.gp import GaussianProcess, Hyper, correlation
+from shockcal.emulator.pcgp import Z90
 from shockcal.plots.style import COLORS, no_data, styled, subplots
 
 THETA_RUNS = np.array([0.05, 0.35, 0.65, 0.95])
 GRID = np.linspace(0.0, 1.0, 401)
-Z90 = 1.645
 # Fixed toy hyperparameters for the project's GP (shockcal.emulator.gp): correlation rho^(4 d^2) with
 # rho = 0.2, marginal sd 0.5 of the centred outputs, a negligible nugget.
 TOY_HYPER = Hyper(lambda_w=4.0, beta=np.array([-4.0 * np.log(0.2)]), lambda_n=1e8)

@@ -40,8 +40,8 @@ class OutputSpec:
         time_unit: us, ns, ms or s. velocity_unit: m/s, cm/us, km/s or mm/us.
     """
 
-    kind: str
-    file: str
+    kind: str = "trace"
+    file: str = "trace.csv"
     time_column: str = "t_us"
     time_unit: str = "us"
     velocity_column: str = "v_m_s"

@@ -6,7 +6,9 @@ Layers, each importing only those above it and the library:
   `emulator_spec`, `calibration_settings`, ...), the design and the measured features of the study;
 - `validate`: reading a config file, its schema and the rules across keys, the design file's check;
 - `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands;
-- `next_shot_check`: the next-shot check's candidates as fourth shots of derived configs;
+- `strength_config`: the `strength` section: the law's prior box, checked before any run;
+- `candidate_studies`: the next-shot check's candidates as fourth shots of derived configs;
+- `figure_catalogue`: the figures, what each reads of the config and its inputs, and which function draws it;
 - `workflow`, `stage_times`: the Snakefile's helpers and the per-stage cost table from its benchmark files;
 - `snakemake_console`: snakemake's console at one progress line (`snakemake --logger shockcal`, what `make` runs).
 

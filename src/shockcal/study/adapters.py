@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.laws import get_law
+from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.seeds import stream_seed
 from shockcal.study.config import (
     AUTO_END_MARGIN_US,
@@ -28,7 +29,7 @@ from shockcal.study.config import (
     velocity_box_m_s,
     wave_sizes,
 )
-from shockcal.study.strength import DEFAULT_MODEL, strength_model, strength_parameters
+from shockcal.study.strength_config import DEFAULT_MODEL, strength_model, strength_parameters
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -61,10 +62,8 @@ def shot_mapping(config: dict, shot: str) -> ShotMapping:
 
 
 def material_properties(config: dict) -> MaterialProperties:
-    """`material`, its `eos` sub-section flattened."""
-    material = config["material"]
-    flat = {**{k: v for k, v in material.items() if k != "eos"}, **material["eos"]}
-    return MaterialProperties(**{f.name: float(flat[f.name]) for f in fields(MaterialProperties)})
+    """`material` (a library name, overrides, either EOS form: `shockcal.hydro.material_library.material_properties`)."""
+    return library_material_properties(config["material"])
 
 
 def hydro_settings(config: dict) -> HydroSettings:
@@ -332,7 +331,7 @@ def observed_table(config: dict) -> pd.DataFrame:
                                            stream_seed(config["study"]["seed"], "readout", shot))})
         else:
             where = f"observed.features.{shot}"
-            rows.append({"shot": shot, "source": "published (Walters et al. 2018, LA-UR-18-20151)",
+            rows.append({"shot": shot, "source": f"published ({where})",
                          **observed["features"][shot], **dict.fromkeys(READOUT_COLUMNS, 0.0),
                          "noise_sd_m_s": float("nan"), "noise_ar_order": 0, "readout_half_window_ns": 0.0})
         box = velocity_box_m_s(config, shot)

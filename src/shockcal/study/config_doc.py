@@ -24,7 +24,8 @@ PLACEHOLDERS = {"shots": "<shot>", "inputs": "<input>", "observed.features": "<s
                 "calibration.cube_power": "<input>", "strength.inputs": "<parameter>",
                 "next_shot.candidates": "<candidate>", "next_shot.readout_sd_m_s": "<feature>",
                 "simulator.command.env": "<variable>", "simulator.archive.features": "<shot>",
-                "simulator.archive.traces": "<shot>"}
+                "simulator.archive.traces": "<shot>", "study.report_notes": "<caption>",
+                "study.reference_sets[].values": "<parameter>"}
 # unit suffixes of key names (shockcal's "units in names"), longest match first
 UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K"), ("_g_cc", "g/cc"), ("_Mbar", "Mbar"), ("_mm", "mm"),
                  ("_um", "um"), ("_us", "us"), ("_ns", "ns"), ("_K", "K"))
@@ -138,6 +139,9 @@ def _walk(root: dict, node: dict, path: tuple[str, ...]) -> Iterator[Key]:
         child = _resolve(root, sub)
         yield Key((*path, name), child, name in required)
         yield from _walk(root, child, (*path, name))
+    items = _resolve(root, node["items"]) if isinstance(node.get("items"), dict) else {}
+    if path and "properties" in items:     # a list of mappings: its items' keys as `<list>[].<key>`
+        yield from _walk(root, items, (*path[:-1], f"{path[-1]}[]"))
     extra = node.get("additionalProperties")
     if isinstance(extra, dict):
         dotted = ".".join(path)
@@ -165,7 +169,7 @@ def _overlaps(path: tuple[str, ...], declared: list[str]) -> bool:
     """Whether a key path and a declared path (STAGE_KEYS syntax) share a key: one is the other's prefix,
     segment by segment, a placeholder or wildcard matching any key; an optional key's `?` is dropped."""
     declared = [*declared[:-1], declared[-1].removesuffix("?")] if declared else declared
-    return all(k == d or d in WILDCARDS or k.startswith("<") for k, d in zip(path, declared))
+    return all(k.removesuffix("[]") == d or d in WILDCARDS or k.startswith("<") for k, d in zip(path, declared))
 
 
 def _scope(declared: list[str]) -> str:
@@ -187,7 +191,7 @@ def _figure_numbers(names: list[str]) -> str:
 
 
 def _figure_reads() -> dict[str, tuple[str, ...]]:
-    from shockcal.plots.catalogue import catalogue
+    from shockcal.study.figure_catalogue import catalogue
 
     return {name: spec.reads for name, spec in catalogue(FIGURE_SHOTS).items()}
 
@@ -233,7 +237,7 @@ def _range(s: dict) -> str:
 
 def _default(s: dict, required: bool) -> str:
     if "default" in s:
-        return f"`{_value(s['default'])}`"
+        return '`""`' if s["default"] == "" else f"`{_value(s['default'])}`"
     return "*required*" if required else ""
 
 

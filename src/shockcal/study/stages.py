@@ -21,15 +21,20 @@ from collections.abc import Iterable, Iterator
 
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
-from shockcal.study.strength import strength_model
+from shockcal.study.strength_config import strength_model
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "strength.model?")
 
+# the material's constants, not its library `name` (`shockcal.hydro.material_library`): a config naming its material and one
+# giving the same values run the same jobs
+_MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material.T_melt_K", "material.cv_J_per_kg_K",
+             "material.strain_rate_ref_per_s")
+
 # what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window)
 _CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-              "shots.*.analysis", "inputs", "material")
+              "shots.*.analysis", "inputs", *_MATERIAL)
 _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
@@ -40,7 +45,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "check_design": ("study.seed", "inputs", "calibration.check.trials", "design.base_shots", "checks.design_box",
                      *_SHOT_MAPPING),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto or per_run
-    "simulate": ("material", "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?", "simulator?",
+    "simulate": (*_MATERIAL, "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?", "simulator?",
                  *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
                  "shots.{shot}.analysis.window_after_arrival_us"),
     # features of one shot's traces (one chunk, or a whole run set with the failure budget)
@@ -88,7 +93,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "next_shot_check_truths": ("study.seed", "next_shot.candidates", "next_shot.check.n_truths",
                                "next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K",
                                "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-                               "shots.*.analysis", "inputs", "material"),
+                               "shots.*.analysis", "inputs", *_MATERIAL),
     # the next-shot check's realized gains and sds against the ranking
     "next_shot_check_summary": ("next_shot.targets", "inputs", "strength.model?"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
@@ -117,7 +122,7 @@ def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> N
         return
     del sliced["emulator"]["yield_input"]
     others = [path for stage in stages if stage != "emulate" for path in STAGE_KEYS[stage]]
-    if not {"material", "material.T_ref_K"} & set(others):
+    if "material.T_ref_K" not in others:
         del sliced["material"]["T_ref_K"]
         if not sliced["material"]:
             del sliced["material"]
@@ -125,7 +130,7 @@ def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> N
 
 def figure_config(config: dict, name: str) -> dict:
     """The slice figure `name` reads: the figures stage's keys and its catalogue entry's `reads`."""
-    from shockcal.plots.catalogue import figure_spec
+    from shockcal.study.figure_catalogue import figure_spec
 
     return config_slice(config, [*STAGE_KEYS["figures"], *figure_spec(name, config).reads], label=name)
 

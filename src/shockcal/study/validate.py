@@ -18,11 +18,14 @@ import yaml
 
 from shockcal.errors import ConfigError, InputError, ShockcalError, number
 from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
+from shockcal.hydro.material_library import resolve_material
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
+from shockcal.study.references import check_reference_sets
+from shockcal.study.report_notes import check_report_notes
 from shockcal.study.simulator_rules import check_simulator
-from shockcal.study.strength import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
+from shockcal.study.strength_config import DEFAULT_MODEL, apply_strength_model, next_shot_targets, strength_model
 from shockcal.units import MM_TO_CM
 
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -70,6 +73,7 @@ def validate_config(config: dict, source: str = "config") -> dict:
     from jsonschema.exceptions import ValidationError
 
     _normalise_shot_names(config)
+    resolve_config_material(config, source)
     try:
         _schema_validator().validate(config)
     except ValidationError as exc:
@@ -77,9 +81,22 @@ def validate_config(config: dict, source: str = "config") -> dict:
     apply_strength_model(config, source)
     expand_candidate_grid(config, source)
     check_semantics(config, source)
+    check_reference_sets(config, source)
+    check_report_notes(config, source)
     check_simulator(config, source)
     check_design_file(config, source)
     return config
+
+
+def resolve_config_material(config: dict, source: str = "config") -> None:
+    """`material` in place: its library entry (`name`) under its keys and its EOS as the cubic
+    (`shockcal.hydro.material_library.resolve_material`), before the schema checks it, so every stage reads one form.
+    A bad name or EOS form is a ConfigError naming the key; a section that is not a mapping is the schema's."""
+    if isinstance(config.get("material"), Mapping):
+        try:
+            config["material"] = resolve_material(config["material"])
+        except InputError as exc:
+            raise ConfigError(f"{source}: {exc}") from None
 
 
 def _schema_validator():

@@ -49,9 +49,10 @@ def next_shot_targets(config: dict) -> list[str]:
 def apply_strength_model(config: dict, source: str) -> None:
     """For a law other than Johnson-Cook: `inputs` becomes the law's box (declared units) followed by the
     shots' velocity inputs and, for a law without a G law, their shear-modulus inputs; `calibration.cube_power`
-    drops Johnson-Cook's inputs. ConfigError naming the key: a parameter the law does not have, a missing
-    bound, min >= max, an input that is neither the law's nor a shot's, a box corner whose flow stress is
-    negative or not finite."""
+    drops Johnson-Cook's inputs the law does not have (a Johnson-Cook config's power, kept by an overlay that
+    cannot delete it); a name the law has (Steinberg-Guinan's n) keeps its power. ConfigError naming the key:
+    a parameter the law does not have, a missing bound, min >= max, an input that is neither the law's nor a
+    shot's, a box corner whose flow stress is negative or not finite."""
     model = strength_model(config)
     if model == DEFAULT_MODEL:
         return
@@ -83,7 +84,8 @@ def apply_strength_model(config: dict, source: str) -> None:
     config["inputs"] = {**box, **_shot_inputs(config, law, given, source)}
     section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
     cube = config["calibration"]["cube_power"]
-    config["calibration"]["cube_power"] = {k: v for k, v in cube.items() if k not in JOHNSON_COOK_INPUTS}
+    config["calibration"]["cube_power"] = {k: v for k, v in cube.items()
+                                           if k in config["inputs"] or k not in JOHNSON_COOK_INPUTS}
 
 
 def _file_box(path: str, law_name: str, source: str) -> dict:

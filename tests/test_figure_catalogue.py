@@ -12,8 +12,8 @@ from matplotlib.image import imread
 from shockcal.cli import main
 from shockcal.cli.figures import parse_inputs
 from shockcal.errors import InputError
-from shockcal.plots.catalogue import INPUT_KINDS, FigureInputs, build_figure, catalogue, history_names
 from shockcal.plots.style import save_figure
+from shockcal.study.figure_catalogue import INPUT_KINDS, FigureInputs, build_figure, catalogue, history_names
 
 CONFIG = str(Path(__file__).resolve().parents[1] / "config" / "config.yaml")
 TOYS = {"fig01_toy_calibration", "fig03_gp_draws", "fig14_inadequate_model"}

@@ -28,6 +28,7 @@ from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY, Candidate, can
 from shockcal.campaign.next_shot import normal_scores
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
+from shockcal.inference.problem import LAMBDA_Y
 
 
 def truth_design(posterior: pd.DataFrame, names: Sequence[str], candidates: Mapping[str, tuple[Candidate, str, str | None]],
@@ -58,7 +59,7 @@ def truth_design(posterior: pd.DataFrame, names: Sequence[str], candidates: Mapp
     designs = {name: candidate_design(posterior, names, candidate, n, seed, material, velocity_sd_fraction,
                                       slope_per_K, bounds, source)
                for name, (candidate, _, _) in candidates.items()}
-    truths = next(iter(designs.values()))[["run", *names, "lambda_y"]].copy()
+    truths = next(iter(designs.values()))[["run", *names, LAMBDA_Y]].copy()
     for name, (candidate, velocity_input, increment_input) in candidates.items():
         design = designs[name]
         truths[velocity_input] = design[VELOCITY]

@@ -2,7 +2,8 @@
 function draws it.
 
 Importing this module is cheap (the Snakefile lists the figures from it); plotting modules are
-imported when a figure is built.
+imported when a figure is built. It lives in the study package, beside the other config readers: the
+plotting modules (`shockcal.plots`) import nothing of the study package.
 
 Inputs arrive as named files (`FigureInputs`): keys `<kind>` or `<kind>:<shot or calibration>`
 with the kinds of `INPUT_KINDS` (`observed`, `posterior:joint`, `features:104S`, ...); a key may
@@ -14,6 +15,7 @@ InputError. Each entry says which keys it `needs` for the config's shots, and th
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -27,6 +29,7 @@ if TYPE_CHECKING:
 
 
 # what each input kind is (the workflow's figures.smk maps every kind to its files)
+log = logging.getLogger(__name__)
 INPUT_KINDS = {
     "observed": "the observed features (features/observed.parquet)",
     "cv": "the emulator's cross-validation table (emulator/cv.parquet)",
@@ -124,16 +127,26 @@ def _crossval(inputs, config):
     return fig06_crossval(inputs.table("cv"), _shots(config))
 
 
+def _references(config):
+    """The study's reference sets to draw (`study.reference_sets` of its law); a value outside the prior box
+    is drawn and logged, not refused."""
+    from shockcal.study.references import drawn_sets, outside_box
+
+    for line in outside_box(config):
+        log.warning(line)
+    return drawn_sets(config)
+
+
 def _marginals(inputs, config):
     from shockcal.plots.posterior import fig07_marginals
 
-    return fig07_marginals(inputs.per("posterior", [*_shots(config), "joint"]), config)
+    return fig07_marginals(inputs.per("posterior", [*_shots(config), "joint"]), config, _references(config))
 
 
 def _pairs(inputs, config):
     from shockcal.plots.posterior import fig08_pairs
 
-    return fig08_pairs(inputs.table("posterior:joint"), config)
+    return fig08_pairs(inputs.table("posterior:joint"), config, references=_references(config))
 
 
 def _features_emulator(inputs, config):
@@ -183,7 +196,7 @@ def _sobol(inputs, config):
 
 def _next_shot(inputs, config):
     from shockcal.plots.next_shot import next_shot_ranking
-    from shockcal.study.strength import next_shot_targets
+    from shockcal.study.strength_config import next_shot_targets
 
     return next_shot_ranking(inputs.table("next_shot_ranking"), next_shot_targets(config))
 
@@ -194,10 +207,10 @@ def history_names(config) -> dict[str, str]:
 
 
 # what the builders read: the shots (names, analysis windows), the records' columns, the extractor's
-# settings, the prior box, the observation error, the figures' random stream
+# settings, the prior box and the reference sets of its law, the observation error, the figures' random stream
 _RECORDS = ("shots", "observed.records")
 _TRACE = (*_RECORDS, "features")
-_POSTERIOR = ("shots", "inputs")
+_POSTERIOR = ("shots", "inputs", "strength.model?", "study.reference_sets?")
 _FEATURE_SPACE = ("shots", "observed.sd_fraction")
 
 
