@@ -107,7 +107,7 @@ def test_the_study_emulator_hands_each_shot_its_training_features():
 
 
 def test_the_report_figure_is_registered_and_names_a_feature_outside(paper_config):
-    from shockcal.plots.catalogue import FigureInputs, catalogue
+    from shockcal.study.figure_catalogue import FigureInputs, catalogue
 
     spec = catalogue(paper_config)["features_vs_training"]
     assert spec.target == "all" and set(spec.needs) == {"features:104S", "features:105S", "features:106S", "observed"}
