@@ -29,8 +29,9 @@ def jc_config(paper_config_readonly):
 
 def test_fifteen_figures_in_the_papers_order(paper_config):
     names = list(catalogue(paper_config))
-    assert len(names) == 17 and names[15] == "sobol_indices"          # the paper's fifteen, then the study's own
-    assert names[16] == "next_shot" and catalogue(paper_config)["next_shot"].target == "next_shot"   # not in `all`
+    assert len(names) == 18 and names[15] == "sobol_indices"          # the paper's fifteen, then the study's own
+    assert names[16] == "features_vs_training" and catalogue(paper_config)["features_vs_training"].target == "all"
+    assert names[17] == "next_shot" and catalogue(paper_config)["next_shot"].target == "next_shot"   # not in `all`
     assert [int(name[3:5]) for name in names[:15]] == list(range(1, 16))
     assert history_names(paper_config) == {"fig11_history_104S": "104S", "fig12_history_105S": "105S",
                                            "fig13_history_106S": "106S"}

@@ -57,7 +57,7 @@ def test_the_slice_is_a_copy(config):
 
 
 def test_only_history_figures_read_the_seed(config):
-    seeded = {name for name in catalogue(config) if "study" in figure_config(config, name)}
+    seeded = {name for name in catalogue(config) if "seed" in figure_config(config, name).get("study", {})}
     assert seeded == {"fig11_history_104S", "fig12_history_105S", "fig13_history_106S"}
 
 

@@ -198,6 +198,15 @@ class Emulator:
             cov[:, dst[:, None], dst[None, :]] = c[:, src[:, None], src[None, :]]
         return mean, cov
 
+    def training_features(self, shot: str) -> pd.DataFrame:
+        """The training runs' calibration features of `shot` (m/s; a row per run, indexed by run id)."""
+        self._check_shots([shot])
+        block = next(b for b in self.blocks if shot in b.shots)
+        k = len(self.feature_names)
+        start = k * block.shots.index(shot)
+        return pd.DataFrame(block.model.y_train[:, start:start + k], columns=self.feature_names,
+                            index=pd.Index(block.runs, name="run"))
+
     def error_groups(self, shots) -> list[tuple[np.ndarray, ErrorModel]]:
         """Per block, the columns of `predict(..., shots)` it predicts and its error model: blocks'
         errors are independent, so a likelihood is the sum of one error density per group."""

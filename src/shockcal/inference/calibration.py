@@ -14,6 +14,7 @@ import pandas as pd
 
 from shockcal.inference.problem import LAMBDA_Y, Problem
 from shockcal.inference.sampler import Posterior, SamplerSettings, sample
+from shockcal.inference.training_range import check_training_range
 from shockcal.plausibility import check_observed_table, check_plateau
 
 
@@ -33,6 +34,9 @@ class CalibrationSettings:
         velocity_boxes: shot -> its impact-velocity box (m/s), against which each shot's measured
             plastic plateau is checked (`shockcal.plausibility.check_plateau`); shots absent: unchecked.
         check_plateau: whether a plateau outside the band stops the calibration (else a warning).
+        check_training_range: whether a measured feature outside the training runs' range (widened by
+            `shockcal.inference.training_range.RANGE_MARGIN`) stops the calibration before it starts (else a
+            warning; config `checks.features_in_training_range`).
     """
 
     sampler: SamplerSettings = SamplerSettings()
@@ -43,6 +47,7 @@ class CalibrationSettings:
     bounds: Mapping[str, tuple[float, float]] | None = None
     velocity_boxes: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     check_plateau: bool = True
+    check_training_range: bool = True
 
     def with_sampler(self, **changes) -> CalibrationSettings:
         """These settings with some sampler settings changed (e.g. `seed`, `n_eff`)."""
@@ -54,7 +59,8 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     """Calibrate `shots` jointly (one shot = single-shot calibration).
 
     Args:
-        emulator: the study's `Emulator`.
+        emulator: the study's `Emulator`; its training runs' features (`training_features`) bound the
+            measured ones (`settings.check_training_range`).
         shots: the shots calibrated together.
         observed: measured features, one row per shot (m/s and us).
         settings: sampler, observation sd, checks and units.
@@ -66,10 +72,14 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction, source, settings.bounds,
                                 settings.units)
     check_observed_table(observed, shots, source, settings.check_units)
-    for shot, features in zip(shots, problem.observed.reshape(len(shots), -1)):
+    measured = {shot: dict(zip(emulator.feature_names, features))
+                for shot, features in zip(shots, problem.observed.reshape(len(shots), -1))}
+    for shot, features in measured.items():
         if shot in settings.velocity_boxes:
-            check_plateau(dict(zip(emulator.feature_names, features)), settings.velocity_boxes[shot],
-                          f"{source}: shot {shot}", settings.check_plateau)
+            check_plateau(features, settings.velocity_boxes[shot], f"{source}: shot {shot}", settings.check_plateau)
+    if hasattr(emulator, "training_features"):     # the study's emulator; a stand-in without training runs is not checked
+        check_training_range(measured, {shot: emulator.training_features(shot) for shot in shots}, source,
+                             settings.check_training_range)
     posterior = sample(problem, settings.sampler, other_powers="ignore")
     units = {**{k: settings.units.get(k, "-") for k in problem.names}, LAMBDA_Y: "-"}
     posterior.units = units

@@ -47,7 +47,9 @@ def observation_sd(measured: pd.Series, column: str, sd_fraction: float) -> floa
     return float(np.hypot(sd_fraction * abs(float(measured[column])), readout if np.isfinite(readout) else 0.0))
 
 
-def _panel(ax, column, training, predicted, measured, sd):
+def feature_panel(ax, column, training, predicted, measured, sd):
+    """One panel: densities of the training runs and of the predictions (either may be None), the measured
+    value with its +-2 sd band (None: not drawn), x limits over all of them (m/s)."""
     finite = [t[column].dropna().to_numpy(float) for t in (training, predicted) if t is not None and column in t.columns]
     finite = [v for v in finite if v.size]
     if measured is not None:
@@ -85,7 +87,7 @@ def feature_space(training: dict, predicted: dict, observed: pd.DataFrame | None
         for c, column in enumerate(cols):
             value = None if measured is None or column not in measured else float(measured[column])
             sd = None if value is None else observation_sd(measured, column, sd_fraction)
-            _panel(axes[r, c], column, train, pred, value, sd)
+            feature_panel(axes[r, c], column, train, pred, value, sd)
         axes[r, 0].set_ylabel(shot, fontsize=10, fontweight="bold")
         missing = [what for what, table in (("training runs", train), (f"predictions ({source})", pred),
                                             ("measurement", measured)) if table is None or len(table) == 0]

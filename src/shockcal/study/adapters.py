@@ -170,7 +170,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
     """`calibration` (with `check`, the synthetic-truth trials' `calibration.check`, whose draws are its
     n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units`, the
     prior box `inputs` and their units, the shots' impact-velocity boxes for the plateau check
-    (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), seeded by the shots'
+    (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), the training-range check
+    (`checks.features_in_training_range`; the check's synthetic measurements only warn), seeded by the shots'
     "calibration" stream of study.seed (a trial reseeds from its own); the summary's user units
     (`input_user_units`)."""
     from shockcal.inference.calibration import CalibrationSettings
@@ -188,7 +189,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
                                units={name: box["unit"] for name, box in config["inputs"].items()},
                                user_units=input_user_units(config), bounds=prior_bounds(config),
                                velocity_boxes={shot: box for shot, box in boxes.items() if box is not None},
-                               check_plateau=config["checks"]["plateau_vs_velocity"])
+                               check_plateau=config["checks"]["plateau_vs_velocity"],
+                               check_training_range=config["checks"]["features_in_training_range"] and not check)
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False

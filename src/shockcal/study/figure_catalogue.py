@@ -180,6 +180,14 @@ def _history(shot, inputs, config):
                        seed=stream_seed(config["study"]["seed"], "figures"))
 
 
+def _measured_against_training(inputs, config):
+    from shockcal.plots.training_range import measured_against_training
+
+    shots = _shots(config)
+    return measured_against_training(inputs.per("features", shots), inputs.table("observed"), shots,
+                                     config["observed"]["sd_fraction"])
+
+
 def _sobol(inputs, config):
     from shockcal.plots.sensitivity import sobol_indices
 
@@ -244,6 +252,8 @@ def catalogue(config) -> dict[str, FigureSpec]:
                    trace),
         # beyond the paper
         FigureSpec("sobol_indices", "6 sensitivity", _sobol, ("shots",), ("sobol",)),
+        FigureSpec("features_vs_training", "2 data", _measured_against_training, _FEATURE_SPACE,
+                   (*features, "observed")),
         # which shot next (`make next-shot`), when the config has candidates
         *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets", "strength.model?", "inputs"), ("next_shot_ranking",),
                       "next_shot")] if config.get("next_shot", {}).get("candidates") else []),

@@ -36,7 +36,8 @@
 5. Times: jump-off = 0.01 quantile and elastic plateau = 0.99 quantile of the early mixture; slope
    points = 0.1 and 0.9 quantiles of the late mixture; plastic plateau = the time the standardized
    trace reaches 0.995. Each velocity is the trace's value at that time (a noisy trace: the value of a
-   least-squares line over the record's read-out window, `shockcal.velocimetry.record_noise`).
+   least-squares line over the record's read-out window, `shockcal.velocimetry.record_noise`; the slope
+   points over at most `RISE_SHARE` of the plastic rise time, `slope_half_window_us`).
 6. A noisy trace's read-out error: the spread of its features over replicates of its noise
    (`readout_replicates`, `readout_sd`), which the calibration adds to the 1% observation sd.
 """
@@ -71,6 +72,7 @@ PRE_ARRIVAL_US = 0.05
 PLASTIC_LEVEL = 0.995
 NOISE_FLOOR = 1e-4          # a trace is noisy (read robustly) above this robust sd before arrival, share of its range
 NOISE_PLATEAU_LEVEL = 0.97  # a record's noise is estimated where its monotone fit has passed this level
+RISE_SHARE = 0.15          # the slope points' read-out half-window at most this share of the plastic rise time
 MIXTURE_STARTS = 3         # EM starts: quantile-spaced means, then k-means seeded 0, 1, ...
 MIXTURE_TOL = 1e-5         # EM stops when the mean log-likelihood gains less than this
 MIXTURE_MAX_ITER = 1000
@@ -114,6 +116,7 @@ class Extraction:
     mixture: Mixture
     early: np.ndarray        # boolean mask of early components
     noise: object = None     # the record's NoiseModel (shockcal.velocimetry.record_noise) when read robustly, else None
+    slope_half_window_us: float = 0.0   # the slope points' read-out half-window (`slope_half_window_us`)
 
 
 def baseline_and_noise(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
@@ -201,8 +204,10 @@ def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str
     early = split_early(mixture, cutoff)
     times = feature_times(tw, y, mixture, early, cutoff)
     noise = record_noise(t, v, float(tw[np.argmax(y >= NOISE_PLATEAU_LEVEL)]), end) if robust else None
-    features = feature_values(t, v, times, 0.0 if noise is None else noise.half_window_us)
-    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early, noise)
+    half_window = 0.0 if noise is None else noise.half_window_us
+    slope_window = slope_half_window_us(half_window, times)
+    features = feature_values(t, v, times, half_window, slope_window)
+    return Extraction(features, arrival, cutoff, (start, end), tw, y, samples, mixture, early, noise, slope_window)
 
 
 def is_noisy(v_before_arrival: np.ndarray, range_m_s: float) -> bool:
@@ -271,12 +276,24 @@ def feature_times(t_window, cdf_window, mixture: Mixture, early: np.ndarray, cut
             "plastic": float(t_window[np.argmax(cdf_window >= PLASTIC_LEVEL)])}
 
 
-def feature_values(t, v, times: dict, half_window_us: float = 0.0) -> dict:
-    """The ten feature values: the times (us) and the trace's velocity at each (m/s, `read_velocity`)."""
+def slope_half_window_us(half_window_us: float, times: dict) -> float:
+    """The slope points' read-out half-window (us): the record's (`half_window_us`, from its noise) or, on a
+    steeper plastic rise, `RISE_SHARE` of its rise time (slope point 1 to slope point 2, `times` in us),
+    whichever is smaller. A least-squares line through a rise's foot or shoulder is off by about
+    0.25 (h / rise time)^2 of the rise (a Gaussian-CDF rise, its 10% and 90% points; 0.6% at the share):
+    a 4 ns window on a copper record's 3.3 ns rise read v_slope1 at 3 times its value. The paper's records
+    (rises of 110-160 ns, windows of 4-8 ns) keep their window (docs/features.md, "Steep fronts")."""
+    return min(half_window_us, RISE_SHARE * (times["slope2"] - times["slope1"]))
+
+
+def feature_values(t, v, times: dict, half_window_us: float = 0.0, slope_half_window_us: float | None = None) -> dict:
+    """The ten feature values: the times (us) and the trace's velocity at each (m/s, `read_velocity`): over
+    `half_window_us` (us), the slope points over `slope_half_window_us` (None: the same)."""
     features = {}
     for name in FEATURES:
+        window = slope_half_window_us if name.startswith("slope") and slope_half_window_us is not None else half_window_us
         features[f"t_{name}"] = times[name]
-        features[f"v_{name}"] = read_velocity(t, v, times[name], half_window_us)
+        features[f"v_{name}"] = read_velocity(t, v, times[name], window)
     return features
 
 
@@ -327,7 +344,8 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
                        ) -> pd.DataFrame:
     """The features of `replicates` copies of a noisy trace's signal, each with an independent replicate
     of its noise added: a parametric bootstrap. The signal is the trace smoothed by the read-out's own
-    local line (scipy's Savitzky-Golay filter of order 1 over the read-out window), the noise the AR
+    local line (scipy's Savitzky-Golay filter of order 1 over the slope points' read-out window, which
+    is the record's unless its plastic rise is steep: `slope_half_window_us`), the noise the AR
     model fitted to the trace's plateau residuals (`shockcal.velocimetry.record_noise`). Their spread is the
     extractor's read-out error on the trace.
 
@@ -345,10 +363,11 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     import pandas as pd
 
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
-    noise = extract(t, v, settings).noise
+    extraction = extract(t, v, settings)
+    noise = extraction.noise
     if noise is None:
         raise FeatureError("the trace is noise-free before its arrival (a simulation): it has no noise to replicate")
-    half_width = max(int(round(noise.half_window_us / np.median(np.diff(t)))), 1)
+    half_width = max(int(round(extraction.slope_half_window_us / np.median(np.diff(t)))), 1)
     signal = savgol_filter(v, 2 * half_width + 1, 1)
     rng = np.random.default_rng(seed)
     rows = []
