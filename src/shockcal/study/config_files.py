@@ -113,10 +113,10 @@ def config_files(paths: list[str | Path]) -> list[Path]:
     files: list[Path] = []
     for index, path in enumerate(paths):
         path = Path(path)
-        if index and read_config_file(path).get(EXTENDS) is None:
+        written = read_config_file(path)
+        if index and written.get(EXTENDS) is None:
             chain = [path]
-            present = [key for key in required_keys() if key in read_config_file(path)]
-            if len(present) == len(required_keys()) and not _listed(path, files):
+            if all(key in written for key in required_keys()) and not _listed(path, files):
                 raise ConfigError(f"{shown_path(path)}: a complete study config (no `{EXTENDS}:`) given after "
                                   f"{shown_path(files[0])}; its shots and inputs would merge with that study's: give it "
                                   f"alone, or make it an overlay with `{EXTENDS}:`")
