@@ -81,7 +81,7 @@ def test_every_figure_is_a_real_image(study):
     results, _ = study
     config = load_config(REPO / "config" / "config.yaml")
     names = [name for name, spec in catalogue(config).items() if spec.target == "all"]
-    assert len(names) == 16                                   # the paper's fifteen and the Sobol indices
+    assert len(names) == 17     # the paper's fifteen, the Sobol indices and the measured features against the training runs
     for name in names:
         png, pdf = results / "figures" / f"{name}.png", results / "figures" / f"{name}.pdf"
         image = matplotlib.image.imread(png)
@@ -232,14 +232,14 @@ def test_a_seed_change_reaches_exactly_the_seeded_stages(study, tmp_path):
 
 
 def test_observation_error_reaches_exactly_the_stages_that_use_it(study, tmp_path):
-    """observed.sd_fraction sets the calibrations' likelihood and Figures 9-10's error bars, and
-    nothing else: the declared slices (shockcal.study.stages) list it there and only there. Until the
+    """observed.sd_fraction sets the calibrations' likelihood and the error bars of Figures 9-10 and
+    features_vs_training, and nothing else: the declared slices (shockcal.study.stages) list it there and only there. Until the
     declaration the two figures did not list it and were left stale by a change."""
     results, config = study
     wider = overlay(tmp_path / "sd.yaml", observed={"sd_fraction": 0.02})
     flagged = params_changed(config, wider) - params_changed(config)
     assert flagged == {"calibrate", "posterior_netcdf", "figure_fig09_features_emulator",
-                       "figure_fig10_features_hydrocode"}, flagged
+                       "figure_fig10_features_hydrocode", "figure_features_vs_training"}, flagged
 
 
 def test_coverage_checks_fan_out_in_batches_of_trials(study):

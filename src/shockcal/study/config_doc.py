@@ -16,6 +16,7 @@ from pathlib import Path
 
 from shockcal.errors import ConfigError
 from shockcal.hydro.rules import RULES
+from shockcal.study.config_files import load_schema
 
 DOC_PATH = Path("docs") / "configuration.md"   # relative to the repository root
 
@@ -72,14 +73,6 @@ class Key:
     def name(self) -> str:
         return ".".join(self.path)
 
-
-def load_schema() -> dict:
-    """The study config's JSON Schema (config.schema.yaml)."""
-    import yaml
-
-    from shockcal.study.config_files import SCHEMA_PATH
-
-    return yaml.safe_load(SCHEMA_PATH.read_text())
 
 
 def schema_keys(schema: dict) -> list[Key]:

@@ -21,7 +21,13 @@ from shockcal.hydro.material_library import resolve_material
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
-from shockcal.study.config_files import SCHEMA_PATH, check_filled, merge_config_files, merge_into, shown_path
+from shockcal.study.config_files import (
+    check_filled,
+    load_schema,
+    merge_config_files,
+    merge_into,
+    shown_path,
+)
 from shockcal.study.references import check_reference_sets
 from shockcal.study.report_notes import check_report_notes
 from shockcal.study.simulator_rules import check_simulator
@@ -95,7 +101,7 @@ def _schema_validator():
                     instance[name] = copy.deepcopy(subschema["default"])
         yield from check_properties(validator, properties, instance, schema)
 
-    schema = yaml.safe_load(SCHEMA_PATH.read_text())
+    schema = load_schema()
     return validators.extend(Draft202012Validator, {"properties": fill_defaults, "x-rule": check_rule})(schema)
 
 
