@@ -456,7 +456,7 @@ def test_every_sampler_setting_in_the_schema_has_the_librarys_minimum():
     import yaml
 
     from shockcal.inference.sampler import MIN_N_EFF, MIN_N_LIVE
-    from shockcal.study.validate import SCHEMA_PATH
+    from shockcal.study.config_files import SCHEMA_PATH
 
     found = []
 

@@ -154,7 +154,7 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
     import importlib
     from dataclasses import fields
 
-    from shockcal.study.validate import SCHEMA_PATH
+    from shockcal.study.config_files import SCHEMA_PATH
 
     module, name = target.split(":")
     cls = getattr(importlib.import_module(module), name)
