@@ -122,7 +122,7 @@ def render(schema: dict | None = None) -> str:
             if len(key.path) > 1 and key.path[0] == section.path[0]:
                 s = key.schema
                 lines.append("| " + " | ".join([
-                    f"`{key.name}`", _type(s), _default(s, key.required), _unit(key), _range(s),
+                    f"`{key.name}`", _type(s), default_text(s, key.required), unit_text(key), range_text(s),
                     _markdown(s["description"]), reruns(key.path, figure_reads=figure_reads)]) + " |")
     return "\n".join(lines) + "\n"
 
@@ -205,9 +205,10 @@ def _type(s: dict) -> str:
     return kind
 
 
-def _range(s: dict) -> str:
+def range_text(s: dict) -> str:
+    """A schema entry's limits and choices as text (">= 1", "one of `lhs`, `waves`"); "" when it has none."""
     if "oneOf" in s:
-        return " or ".join(filter(None, (_range(option) for option in s["oneOf"])))
+        return " or ".join(filter(None, (range_text(option) for option in s["oneOf"])))
     parts = []
     low = ("[", s["minimum"]) if "minimum" in s else ("(", s["exclusiveMinimum"]) if "exclusiveMinimum" in s else None
     high = ("]", s["maximum"]) if "maximum" in s else (")", s["exclusiveMaximum"]) if "exclusiveMaximum" in s else None
@@ -229,13 +230,15 @@ def _range(s: dict) -> str:
     return "; ".join(parts)
 
 
-def _default(s: dict, required: bool) -> str:
+def default_text(s: dict, required: bool) -> str:
+    """A schema entry's default as text (in backticks), `*required*` for a required key without one, else ""."""
     if "default" in s:
         return '`""`' if s["default"] == "" else f"`{_value(s['default'])}`"
     return "*required*" if required else ""
 
 
-def _unit(key: Key) -> str:
+def unit_text(key: Key) -> str:
+    """A key's unit as text (its `x-unit`, else what its name says)."""
     if "x-unit" in key.schema:
         return _markdown(key.schema["x-unit"])
     return next((unit for suffix, unit in UNIT_SUFFIXES if key.path[-1].endswith(suffix)), "")

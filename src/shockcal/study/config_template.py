@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import textwrap
 
-from shockcal.study.config_doc import Key, _default, _range, _unit, load_schema, schema_keys
+from shockcal.study.config_doc import Key, default_text, load_schema, range_text, schema_keys, unit_text
 from shockcal.study.config_files import FILL_IN
 
 WIDTH = 110
@@ -145,9 +145,9 @@ def _yaml(value) -> str:
 
 def _about(key: Key) -> str:
     """The inline comment: unit, range, and 'required' or the default when the value shown is not it."""
-    parts = [_unit(key), _range(key.schema)]
+    parts = [unit_text(key), range_text(key.schema)]
     if key.required and "default" not in key.schema:
         parts.append("required")
     elif "default" in key.schema and key.path in (("study", "name"), ("study", "results_dir")):
-        parts.append(f"default {_default(key.schema, key.required)}")
+        parts.append(f"default {default_text(key.schema, key.required)}")
     return "; ".join(part for part in parts if part)
