@@ -23,7 +23,8 @@ from threadpoolctl import threadpool_limits
 
 from shockcal.study.adapters import extractor_settings
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import extract, extract_features, features_table
+from shockcal.velocimetry.feature_tables import features_table
+from shockcal.velocimetry.features import extract, extract_features
 from shockcal.velocimetry.records import read_record
 
 REPO = Path(__file__).resolve().parents[1]

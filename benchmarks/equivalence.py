@@ -32,7 +32,7 @@ def features(out: str, runs: int, perturb: float, config_path: Path, cfl: float 
     from shockcal.simulators.builtin import simulate_design
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping, study_design
     from shockcal.study.validate import load_config
-    from shockcal.velocimetry.features import features_table
+    from shockcal.velocimetry.feature_tables import features_table
 
     config = load_config(config_path)
     if cfl is not None:

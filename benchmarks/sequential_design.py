@@ -68,7 +68,7 @@ def study_config() -> dict:
 def simulate_chunk(task) -> pd.DataFrame:
     """Features of one shot's design rows (a worker process: the config is re-read there)."""
     from shockcal.simulators.builtin import simulate_design
-    from shockcal.velocimetry.features import features_table
+    from shockcal.velocimetry.feature_tables import features_table
 
     shot, design = task
     config = study_config()

@@ -22,13 +22,13 @@ import yaml
 
 from shockcal.hydro import Geometry, ShotParameters, run_shot
 from shockcal.hydro.settings import MaterialProperties
+from shockcal.velocimetry.feature_tables import readout_sd
 from shockcal.velocimetry.features import (
     CALIBRATION_FEATURES,
     ExtractorSettings,
     FeatureError,
     extract,
     readout_replicates,
-    readout_sd,
 )
 from shockcal.velocimetry.record_noise import NoiseModel
 

@@ -29,7 +29,8 @@ from shockcal.reference import require_reference_dir
 from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import emulator_spec, extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import COLUMNS, features_table, record_features
+from shockcal.velocimetry.feature_tables import features_table, record_features
+from shockcal.velocimetry.features import COLUMNS
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 SHOTS = ["104S", "105S", "106S"]

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from shockcal.errors import ShockcalError
-from shockcal.velocimetry.features import check_failures
+from shockcal.velocimetry.feature_tables import check_failures
 
 
 def _table(n_runs: int, n_failed: int) -> pd.DataFrame:

@@ -28,7 +28,7 @@ from shockcal.io import atomic_path, read_table, read_tables, write_table
 from shockcal.study.adapters import calibration_settings, load_study_design, shot_mapping
 from shockcal.study.config import prior_bounds
 from shockcal.study.validate import load_config, validate_config
-from shockcal.velocimetry.features import check_failures
+from shockcal.velocimetry.feature_tables import check_failures
 from shockcal.velocimetry.records import OPT_OUT, read_record
 
 REPO = Path(__file__).resolve().parents[1]
@@ -698,7 +698,8 @@ def _read_posterior(path, config):
 
 
 def _read_chunk(path, config):
-    from shockcal.velocimetry.features import ExtractorSettings, features_table
+    from shockcal.velocimetry.feature_tables import features_table
+    from shockcal.velocimetry.features import ExtractorSettings
 
     return features_table(read_table(path), ExtractorSettings(window_after_arrival_us=0.1, n_samples=300,
                                                               n_components=2), str(path))

@@ -11,6 +11,7 @@ from scipy.stats import norm
 
 from shockcal.errors import InputError
 from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.feature_tables import features_table, record_features
 from shockcal.velocimetry.features import (
     COLUMNS,
     Mixture,
@@ -18,10 +19,8 @@ from shockcal.velocimetry.features import (
     extract_features,
     feature_times,
     feature_values,
-    features_table,
     fit_mixture,
     fit_mixture_exact,
-    record_features,
     split_early,
 )
 from shockcal.velocimetry.mixture_fit import fit_piecewise_linear_cdf

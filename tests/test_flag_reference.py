@@ -13,7 +13,7 @@ import pytest
 
 from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
-from shockcal.velocimetry.features import features_table
+from shockcal.velocimetry.feature_tables import features_table
 
 # The ten 104S runs (A 390-950 MPa: one merged wave) where a cut-off 80 ns after arrival put a broad
 # second component into the elastic mixture: v_elastic 16-33 m/s above FLAG's (RMSE 22 m/s), v_slope1 13-28.

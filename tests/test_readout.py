@@ -12,14 +12,8 @@ from scipy.stats import norm
 
 from shockcal.seeds import stream_seed
 from shockcal.study.adapters import extractor_settings
-from shockcal.velocimetry.features import (
-    CALIBRATION_FEATURES,
-    extract,
-    monotone_cdf,
-    read_velocity,
-    readout_replicates,
-    readout_sd,
-)
+from shockcal.velocimetry.feature_tables import readout_sd
+from shockcal.velocimetry.features import CALIBRATION_FEATURES, extract, monotone_cdf, read_velocity, readout_replicates
 from shockcal.velocimetry.record_noise import NoiseModel, estimate_noise
 from shockcal.velocimetry.records import read_record
 

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
+from shockcal.velocimetry.feature_tables import readout_sd
 from shockcal.velocimetry.features import (
     RISE_SHARE,
     ExtractorSettings,
     extract,
     feature_values,
     readout_replicates,
-    readout_sd,
     slope_half_window_us,
 )
 from shockcal.velocimetry.record_noise import NoiseModel

@@ -154,7 +154,7 @@ def test_wave_design_command_refuses_the_paper_design_in_one_line(tmp_path):
 def test_a_stopped_wave_passes_through_simulate_and_features_with_no_runs(paper_config):
     from shockcal.simulators.builtin import simulate_design
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
-    from shockcal.velocimetry.features import check_failures, features_table
+    from shockcal.velocimetry.feature_tables import check_failures, features_table
 
     bounds = prior_bounds(paper_config)
     empty = pd.DataFrame({"run": np.array([], dtype=np.int64), **{k: np.array([]) for k in bounds}})
@@ -173,7 +173,7 @@ def test_a_stopped_wave_passes_through_simulate_and_features_with_no_runs(paper_
 def test_features_of_a_wave_with_runs_keep_their_values(paper_config):
     from shockcal.simulators.builtin import simulate_design
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping, study_design
-    from shockcal.velocimetry.features import features_table
+    from shockcal.velocimetry.feature_tables import features_table
 
     design, _ = study_design(paper_config, n_runs=2)
     traces = simulate_design(design, shot_mapping(paper_config, "104S"),

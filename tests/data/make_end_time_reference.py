@@ -18,7 +18,7 @@ from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.config import prior_bounds
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import features_table
+from shockcal.velocimetry.feature_tables import features_table
 
 REPO = Path(__file__).resolve().parents[2]
 OUT = Path(__file__).with_name("end_time_reference.csv")

@@ -4,6 +4,7 @@
 #   tests/slurm/cluster.sh start DIR      write DIR/slurm.conf + a munge key, start munged, slurmctld and
 #                                         slurmd (pids in DIR/*.pid); prints `export SLURM_CONF=...`
 #   tests/slurm/cluster.sh stop DIR       stop the three daemons by pid (TERM, then KILL after 10 s)
+#   tests/slurm/cluster.sh clean          remove a configuration link a killed run left behind (see below)
 # The daemons run as root in the foreground of background jobs; nothing is started through init
 # scripts. Everything is written under DIR except one symlink, /run/slurm/conf/slurm.conf -> DIR/slurm.conf
 # (removed by `stop`): the job step inside each job runs `srun` with every SLURM_* variable stripped,
@@ -27,6 +28,21 @@ install() {
 }
 
 RUN_CONF=/run/slurm/conf/slurm.conf
+
+# A run killed outright (SIGKILL, a machine shut down) leaves RUN_CONF pointing at a cluster whose controller
+# is gone. Every Slurm client then waits for it: `scontrol show config` takes 9 s, and snakemake's SLURM plugin
+# runs it each time snakemake starts (`make test` went from 6 to 19 min that way). Remove such a link.
+remove_stale_link() {
+    [ -L "$RUN_CONF" ] || return 0
+    local target cluster pid
+    target=$(readlink "$RUN_CONF")
+    case $target in /tmp/shockcal-slurm.*/cluster/slurm.conf) ;; *) return 0 ;; esac
+    cluster=$(dirname "$target")
+    pid=$(cat "$cluster/slurmctld.pid" 2>/dev/null || true)
+    if [ -n "$pid" ] && kill -0 "$pid" 2>/dev/null; then return 0; fi
+    echo "cluster.sh: removing $RUN_CONF -> $target, left by a run that did not stop (no controller runs there)" >&2
+    rm -f "$RUN_CONF"
+}
 
 free_port() { python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 
@@ -78,6 +94,7 @@ NodeName=$node NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=test Nodes=ALL Default=YES MaxTime=60 State=UP
 CONF
     export SLURM_CONF=$dir/slurm.conf
+    remove_stale_link
     if [ -e /etc/slurm/slurm.conf ] || { [ -e "$RUN_CONF" ] && [ "$(readlink "$RUN_CONF")" != "$dir/slurm.conf" ]; }; then
         echo "cluster.sh: a Slurm configuration exists already (/etc/slurm/slurm.conf or $RUN_CONF):" \
              "this machine has a Slurm of its own; not starting a throwaway one" >&2
@@ -130,5 +147,6 @@ case ${1:-} in
     install) install ;;
     start) start "${2:?cluster.sh start DIR}" ;;
     stop) stop "${2:?cluster.sh stop DIR}" ;;
-    *) echo "usage: $0 install | start DIR | stop DIR" >&2; exit 2 ;;
+    clean) remove_stale_link ;;
+    *) echo "usage: $0 install | start DIR | stop DIR | clean" >&2; exit 2 ;;
 esac

@@ -49,7 +49,7 @@ def run(args) -> int:
     from shockcal.study.adapters import candidate_extractor_settings, extractor_settings
     from shockcal.study.config import candidate_config
     from shockcal.study.stages import is_candidate, load_stage_config
-    from shockcal.velocimetry.features import check_failures, record_features
+    from shockcal.velocimetry.feature_tables import check_failures, record_features
 
     name = args.shot
     candidate = is_candidate(args.config, name)
@@ -62,7 +62,7 @@ def run(args) -> int:
                                                  args.velocity_column)}])
     else:
         from shockcal.io import read_tables
-        from shockcal.velocimetry.features import features_table
+        from shockcal.velocimetry.feature_tables import features_table
 
         if args.tables:
             table = read_tables(args.tables, ["run"], "features")

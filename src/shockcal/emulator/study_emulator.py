@@ -34,7 +34,8 @@ from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path
 from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
-from shockcal.velocimetry.features import CALIBRATION_FEATURES, reason_kind
+from shockcal.velocimetry.feature_tables import reason_kind
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 # extra emulator inputs base^column: config emulator key of the base, design column
 POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
