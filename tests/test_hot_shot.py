@@ -38,7 +38,7 @@ def test_room_temperature_shot_is_the_code_before_bit_for_bit(paper_config):
     spec = {"flyer_mm": 1.0, "target_mm": 1.5}
     runs = [run_shot(params, *hydro_inputs(paper_config, spec)),
             run_shot(params, *hydro_inputs(paper_config, {**spec, "initial_temperature_K": 298.0})),
-            run_shot(params, Geometry(1.0, 1.5, 0.6, initial_temperature_K=298.0))]
+            run_shot(params, Geometry(1.0, 1.5, 0.6, initial_temperature_K=298.0), AL5083)]
     for result in runs:
         np.testing.assert_allclose(result.v_m_s, stored["gray_104"], rtol=1e-10, atol=1e-10 * np.max(np.abs(stored["gray_104"])))
         np.testing.assert_array_equal(result.v_m_s, runs[0].v_m_s)
