@@ -72,7 +72,7 @@ def test_hot_plates_at_rest_stay_at_rest():
     impact velocity must be positive (`shockcal.hydro.rules`): 1e-12 m/s stands for none, a thousandth of the
     bound on the free surface's motion."""
     result = run_shot(ShotParameters.from_table_iv(A_MBAR, 0.0, 0.0, 0.0, M, 1e-16, G_MBAR),
-                      Geometry(0.5, 0.5, 0.2, initial_temperature_K=700.0))
+                      Geometry(0.5, 0.5, 0.2, initial_temperature_K=700.0), AL5083)
     assert result.status == "ok", result.reason
     assert np.max(np.abs(result.v_m_s)) < 1e-9
 

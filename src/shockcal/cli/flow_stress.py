@@ -59,11 +59,19 @@ def run(args) -> int:
     import numpy as np
 
     from shockcal.errors import InputError
-    from shockcal.hydro.laws import flow_stress_curve, get_law, law_values, melt_temperature_K, shear_modulus_gpa
+    from shockcal.hydro.laws import (
+        check_given,
+        flow_stress_curve,
+        get_law,
+        law_values,
+        melt_temperature_K,
+        shear_modulus_gpa,
+    )
     from shockcal.hydro.material_library import load_material
 
     law = get_law(args.model)
     given = parse_params(args.param)
+    check_given(law, given)
     state = {"--strain-rate": args.strain_rate, "--temperature": args.temperature, "--pressure": args.pressure,
              "--density-ratio": args.density_ratio, "--max-strain": args.max_strain}
     for option, value in state.items():

@@ -100,6 +100,7 @@ def material_constants(config: dict, model: str, boxed=(), source: str = "config
     name, from the config's `material` (`shockcal.hydro.laws.law_values`, the one place they are filled); a
     constant the material does not give is a ConfigError naming the material key."""
     law = get_law(model)
+    boxed = [name for name in boxed if name in law.names()]
     try:
         filled = law_values(law, dict.fromkeys(boxed, 0.0), config["material"])
     except InputError as exc:

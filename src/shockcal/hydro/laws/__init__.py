@@ -59,7 +59,6 @@ def law_values(law: Law, values: Mapping, material: MaterialProperties | Mapping
             `material` section, a mapping of the same keys; None: no material (every material constant must
             be in `values`).
     """
-    check_given(law, values)
     filled = dict(values)
     for param in law.params:
         if param.material is None or param.name in filled:
@@ -116,7 +115,9 @@ def _names_known(law: Law, values: Mapping) -> None:
 
 def code_parameters(law: Law, values: Mapping[str, float], material: MaterialProperties | None = None):
     """The law's named tuple in code units from user values (names and units of `law.params`), the material
-    constants not in `values` from `material` (`law_values`)."""
+    constants not in `values` from `material` (`law_values`); an unknown or missing parameter of the law's own
+    is named before a material key."""
+    check_given(law, values)
     merged = user_values(law, law_values(law, values, material))
     return law.code_type(**{p.field: float(merged[p.name]) * p.to_code for p in law.params})
 
