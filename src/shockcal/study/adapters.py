@@ -360,13 +360,14 @@ def archive_source(config: dict, shot: str):
     from shockcal.study.simulator import resolve_path
 
     section = config["simulator"]["archive"]
-    design = resolve_path(section["design"], "simulator.archive.design")
+    design = resolve_path(section["design"], "simulator.archive.design", section)
     if shot in section.get("features", {}):
-        return ArchiveSource(design, features=resolve_path(section["features"][shot], f"simulator.archive.features.{shot}"))
+        return ArchiveSource(design, features=resolve_path(section["features"][shot], f"simulator.archive.features.{shot}",
+                                                           section))
     if shot not in section.get("traces", {}):
         raise ConfigError(f"simulator.archive: no runs of {shot} (neither features.{shot} nor traces.{shot}); an archive "
                           "holds the training runs of the study's shots only")
     pattern = section["traces"][shot]
-    resolved = resolve_path(pattern, f"simulator.archive.traces.{shot}")
+    resolved = resolve_path(pattern, f"simulator.archive.traces.{shot}", section)
     return ArchiveSource(design, traces=str(resolved), trace=OutputSpec(**{**section.get("trace", {}), "kind": "trace",
                                                                             "file": Path(pattern).name}))
