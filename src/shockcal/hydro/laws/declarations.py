@@ -1,9 +1,9 @@
 """Every strength law's parameters, declared in one place: name (unit-suffixed, as the user writes it),
 the symbol of the paper and the kernel's field, user unit, factor to code units (Mbar, K, 1/us, g/cc,
-g/mol; `shockcal.units`), meaning, and either a default (a convention of the law: a reference temperature
-or rate) or the `MaterialProperties` field that gives it (`material`: a property of the study's material,
-density, molar mass, melt temperature, filled by `shockcal.hydro.laws.law_values`); calibrated parameters
-have neither.
+g/mol; `shockcal.units`), meaning, and either a default (a convention of the law: Steinberg-Guinan's eps_i,
+Zerilli-Armstrong's reference rate) or the `MaterialProperties` field that gives it (`material`: a property
+of the study's material, density, molar mass, melt temperature, filled by `shockcal.hydro.laws.law_values`);
+calibrated parameters have neither.
 
 A user value times `to_code` is the kernel's value. Prior boxes for aluminium, with sources, are in
 config/models.yaml (`shockcal.hydro.laws.boxes`).
