@@ -50,12 +50,13 @@ def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
     """The kernel stops `stop_after_rise_us` after the first output above rise_fraction x the impact velocity:
     the same steps as the longer run up to there, so the same outputs bit for bit, and fewer of them."""
     from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
+    from shockcal.hydro.material_library import load_material
 
     params = ShotParameters(A_MPa=170, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
-    coarse = HydroSettings(cell_size_um=20.0)
-    full = run_shot(params, Geometry(3.95, 5.965, 2.30), settings=coarse)
-    short = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=1.2, rise_fraction=0.003),
-                     settings=coarse)
+    coarse, al5083 = HydroSettings(cell_size_um=20.0), load_material("al5083")
+    full = run_shot(params, Geometry(3.95, 5.965, 2.30), al5083, coarse)
+    short = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=1.2, rise_fraction=0.003), al5083,
+                     coarse)
     n = len(short.t_us)
     # bit for bit: one code path in one process, the same steps and arithmetic, only stopped sooner
     rise = full.t_us[np.argmax(full.v_m_s > 0.003 * 204)]
@@ -64,7 +65,7 @@ def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
     np.testing.assert_array_equal(short.v_m_s, full.v_m_s[:n])
     np.testing.assert_array_equal(short.energy_history, full.energy_history[:n])
     assert short.n_steps < full.n_steps
-    late = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=5.0, rise_fraction=0.003), settings=coarse)
+    late = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=5.0, rise_fraction=0.003), al5083, coarse)
     np.testing.assert_array_equal(late.v_m_s, full.v_m_s)                   # end_us comes first
 
 

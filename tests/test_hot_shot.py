@@ -38,7 +38,7 @@ def test_room_temperature_shot_is_the_code_before_bit_for_bit(paper_config):
     spec = {"flyer_mm": 1.0, "target_mm": 1.5}
     runs = [run_shot(params, *hydro_inputs(paper_config, spec)),
             run_shot(params, *hydro_inputs(paper_config, {**spec, "initial_temperature_K": 298.0})),
-            run_shot(params, Geometry(1.0, 1.5, 0.6, initial_temperature_K=298.0))]
+            run_shot(params, Geometry(1.0, 1.5, 0.6, initial_temperature_K=298.0), AL5083)]
     for result in runs:
         np.testing.assert_allclose(result.v_m_s, stored["gray_104"], rtol=1e-10, atol=1e-10 * np.max(np.abs(stored["gray_104"])))
         np.testing.assert_array_equal(result.v_m_s, runs[0].v_m_s)
@@ -72,7 +72,7 @@ def test_hot_plates_at_rest_stay_at_rest():
     impact velocity must be positive (`shockcal.hydro.rules`): 1e-12 m/s stands for none, a thousandth of the
     bound on the free surface's motion."""
     result = run_shot(ShotParameters.from_table_iv(A_MBAR, 0.0, 0.0, 0.0, M, 1e-16, G_MBAR),
-                      Geometry(0.5, 0.5, 0.2, initial_temperature_K=700.0))
+                      Geometry(0.5, 0.5, 0.2, initial_temperature_K=700.0), AL5083)
     assert result.status == "ok", result.reason
     assert np.max(np.abs(result.v_m_s)) < 1e-9
 

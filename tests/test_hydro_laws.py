@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from shockcal.errors import InputError
 from shockcal.hydro import Geometry, LawShotParameters, ShotParameters, run_shot
 from shockcal.hydro import shot as shot_module
-from shockcal.hydro.laws import get_law
+from shockcal.hydro.laws import code_parameters, get_law
 from shockcal.hydro.material_library import load_material
 from shockcal.hydro.state import LawStrength
 from shockcal.units import CM_US_TO_M_S
@@ -62,7 +62,7 @@ def _run_kernel_strength(monkeypatch, params, strength):
     """run_shot with the kernel's strength tuple given exactly (code units), bypassing user-unit rounding."""
     velocity, _ = shot_module.kernel_strength(params, AL5083)
     monkeypatch.setattr(shot_module, "kernel_strength", lambda p, material: (velocity, strength))
-    return run_shot(params, THIN)
+    return run_shot(params, THIN, AL5083)
 
 
 @pytest.mark.parametrize("table_iv", [(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),   # Gray, 104S
@@ -73,7 +73,7 @@ def test_johnson_cook_general_return_equals_the_floored_one(monkeypatch, table_i
     the floored kernel's trace: the floors only skip provably elastic steps. Two kernels, so compared at the
     rounding floor (rtol 1e-10 of the peak; bit for bit on the machines measured)."""
     A, B, C, n, m, velocity, G = table_iv
-    floored = run_shot(ShotParameters.from_table_iv(*table_iv), THIN)
+    floored = run_shot(ShotParameters.from_table_iv(*table_iv), THIN, AL5083)
     law = get_law("johnson-cook").code_type(A, B, C, n, m, AL5083.T_ref_K, AL5083.T_melt_K, AL5083.rate_ref_per_us())
     general = _run_kernel_strength(monkeypatch, ShotParameters.from_table_iv(*table_iv), LawStrength(law, G))
     assert floored.status == general.status == "ok"
@@ -89,10 +89,10 @@ def test_steinberg_guinan_without_pressure_temperature_or_hardening_is_constant_
     per-cell modulus, or a unit slip, breaks the equality (two kernels: at the rounding floor, rtol 1e-10)."""
     sg = LawShotParameters("sg", {"Y0_GPa": 0.31, "Ymax_GPa": 0.68, "beta": 0.0, "n": 0.1, "G0_GPa": 25.0,
                                   "dGdP": 0.0, "dGdT_over_G0_per_K": 0.0}, V_104S)
-    code = sg.law_parameters()
+    code = sg.law_parameters(AL5083)
     assert code.G0 == 0.25
     jc = ShotParameters.from_table_iv(code.Y0, 0.0, 0.0, 0.0, 1000.0, sg.velocity_m_s / CM_US_TO_M_S, code.G0)
-    a, b = run_shot(sg, THIN), run_shot(jc, THIN)
+    a, b = run_shot(sg, THIN, AL5083), run_shot(jc, THIN, AL5083)
     assert a.status == b.status == "ok"
     np.testing.assert_allclose(a.v_m_s, b.v_m_s, rtol=1e-10, atol=1e-10 * np.max(np.abs(b.v_m_s)))
     assert a.max_plastic_strain == pytest.approx(b.max_plastic_strain, rel=1e-10) and b.max_plastic_strain > 0.0
@@ -106,14 +106,14 @@ def test_law_floors_change_no_trace():
     stored = np.load(Path(__file__).parent / "data" / "law_traces_before_law_floors.npz")
     assert set(stored.files) == set(LAW_FLOOR_CASES)
     for name, params in LAW_FLOOR_CASES.items():
-        np.testing.assert_allclose(run_shot(params, THIN).v_m_s, stored[name], rtol=1e-10,
+        np.testing.assert_allclose(run_shot(params, THIN, AL5083).v_m_s, stored[name], rtol=1e-10,
                                    atol=1e-10 * np.max(np.abs(stored[name])), err_msg=name)
 
 
 @pytest.mark.parametrize("model", list(LAW_RUNS))
 def test_law_run_completes_and_conserves_energy(model):
     """A 104S-like run per law completes, with the energy error bound of tests/test_hydro.py (1e-3)."""
-    result = run_shot(LAW_RUNS[model], THIN)
+    result = run_shot(LAW_RUNS[model], THIN, AL5083)
     assert result.status == "ok", result.reason
     assert result.energy_error < 1e-3
     assert 190.0 < result.v_m_s.max() < 215.0                 # the plateau near the impact velocity
@@ -123,8 +123,8 @@ def test_law_run_completes_and_conserves_energy(model):
 def test_steinberg_guinan_modulus_enters_the_elastic_update():
     """A stiffer G(P) (dGdP 1.8 -> 3.6) makes the elastic precursor arrive earlier: the per-cell G reaches
     the elastic trial and the sound speed, not only the flow stress."""
-    soft = run_shot(LAW_RUNS["steinberg-guinan"], THIN)
-    stiff = run_shot(LawShotParameters("sg", {**STEINBERG_6061, "dGdP": 3.6}, V_104S), THIN)
+    soft = run_shot(LAW_RUNS["steinberg-guinan"], THIN, AL5083)
+    stiff = run_shot(LawShotParameters("sg", {**STEINBERG_6061, "dGdP": 3.6}, V_104S), THIN, AL5083)
     t = soft.t_us
     level = 20.0
     assert t[np.argmax(stiff.v_m_s > level)] < t[np.argmax(soft.v_m_s > level)]
@@ -139,8 +139,7 @@ def _yield_jump(law, law_values, G_const_GPa, T0=AL5083.T_ref_K):
     the jump's energy up^2/2 (its temperature rise, ~0.01 K, is left out of G and Y). With constant G this is
     log strain Y / 2G: sigma_HEL = P + 2Y/3 = Y (1 - nu)/(1 - 2 nu) for the linear EOS K = c1.
     Returns the free-surface velocity 2 up (m/s)."""
-    code = law.code_type(**{p.field: float({**{q.name: q.default for q in law.params}, **law_values}[p.name])
-                            * p.to_code for p in law.params})
+    code = code_parameters(law, law_values, AL5083)
     G_const = (G_const_GPa or 0.0) / 100.0
     rho0, c1, c2, c3, g0 = AL5083.rho0_g_cc, AL5083.c1_Mbar, AL5083.c2_Mbar, AL5083.c3_Mbar, AL5083.gamma0
 
@@ -187,7 +186,7 @@ def test_elastic_precursor_is_the_laws_hel(model):
     expected, speed = _yield_jump(law, values, G)
     target_mm = 6.0
     t_elastic = target_mm * 0.1 / speed
-    result = run_shot(LawShotParameters(model, values, V_104S, G), Geometry(2.0, target_mm, t_elastic + 0.05))
+    result = run_shot(LawShotParameters(model, values, V_104S, G), Geometry(2.0, target_mm, t_elastic + 0.05), AL5083)
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s
     plateau = np.median(v[(t > t_elastic + 0.02) & (t < t_elastic + 0.045)])
@@ -214,9 +213,10 @@ def test_law_kernels_load_from_numba_cache_in_a_second_process(tmp_path):
     import sys
 
     script = ("from shockcal.hydro import Geometry, LawShotParameters, run_shot\n"
+              "from shockcal.hydro.material_library import load_material\n"
               "from shockcal.hydro.solver import simulate\n"
               f"params = LawShotParameters('sg', {STEINBERG_6061!r}, 204.0)\n"
-              "assert run_shot(params, Geometry(0.05, 0.05, 0.01)).status == 'ok'\n"
+              "assert run_shot(params, Geometry(0.05, 0.05, 0.01), load_material('al5083')).status == 'ok'\n"
               "print(len(simulate.stats.cache_hits), len(simulate.stats.cache_misses))\n")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     first, second = (subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)

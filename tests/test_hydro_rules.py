@@ -52,7 +52,7 @@ def test_a_plate_thinner_than_one_cell_is_refused_before_the_run():
     params = ShotParameters(**JC_104S, velocity_m_s=204)
     with pytest.raises(InputError, match=r"Geometry.target_mm: 0.001 mm is thinner than one cell of the mesh "
                                          r"\(cell_size_um = 4 um\)"):
-        run_shot(params, Geometry(flyer_mm=3.95, target_mm=0.001, end_us=0.1))
+        run_shot(params, Geometry(flyer_mm=3.95, target_mm=0.001, end_us=0.1), AL5083)
 
 
 @pytest.mark.parametrize("section, key, value, library", [

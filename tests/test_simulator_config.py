@@ -90,6 +90,28 @@ def test_an_archive_whose_features_hold_runs_the_design_lacks_is_refused(archive
     assert "\n" not in str(err.value)
 
 
+def test_reference_data_is_the_configs_folder_unless_the_environment_names_one(archive, monkeypatch, tmp_path):
+    """{reference_data} stands for simulator.archive.reference_data, $SHOCKCAL_REFERENCE_DATA overriding it
+    (no folder is built into the code); neither, or a folder that is not there, is one line naming the key."""
+    config, folder = archive
+    archive_section = config["simulator"]["archive"]
+    archive_section.update(design="{reference_data}/design.csv",
+                           features={shot: f"{{reference_data}}/{shot}.csv" for shot in config["shots"]})
+    monkeypatch.delenv("SHOCKCAL_REFERENCE_DATA", raising=False)
+    with pytest.raises(ConfigError, match=r"simulator\.archive\.design: \{reference_data\}/design\.csv: "
+                                          r"\{reference_data\} names no folder") as err:
+        validate_config(dict(config, simulator={"kind": "archive", "archive": dict(archive_section)}))
+    assert "\n" not in str(err.value)
+    archive_section["reference_data"] = str(tmp_path / "elsewhere")
+    with pytest.raises(ConfigError, match=r"folder .*elsewhere does not exist here"):
+        validate_config(dict(config, simulator={"kind": "archive", "archive": dict(archive_section)}))
+    monkeypatch.setenv("SHOCKCAL_REFERENCE_DATA", str(folder))
+    assert study_design(validate_config(config))[0]["run"].tolist() == list(range(6))
+    monkeypatch.delenv("SHOCKCAL_REFERENCE_DATA")
+    archive_section["reference_data"] = str(folder)
+    assert study_design(validate_config(config))[0]["run"].tolist() == list(range(6))
+
+
 def test_an_archive_whose_shots_hold_other_runs_is_refused(archive):
     config, folder = archive
     pd.read_csv(folder / "106S.csv").iloc[:4].to_csv(folder / "106S.csv", index=False)

@@ -40,6 +40,7 @@ from shockcal.hydro.laws.steinberg_guinan import (
     steinberg_guinan_melt_temperature_below,
     steinberg_guinan_shear_modulus,
 )
+from shockcal.hydro.material_library import load_material
 from shockcal.hydro.plastic_return import LAW_FLOOR_SLACK, homologous_temperature
 from shockcal.hydro.state import Material
 from shockcal.hydro.strength import equivalent_strain_rate, flow_stress, hardening, thermal_factor
@@ -62,6 +63,7 @@ SG_SETS = [
     dict(Y0_GPa=0.4, Ymax_GPa=0.45, beta=20, n=0.3, eps_i=0.01, G0_GPa=35.0, dGdP=2.5, dGdT_over_G0_per_K=-9e-4,
          T_m0_K=1100.0, gamma0=1.8, a=1.2),                                                                   # capped
 ]
+AL5083 = load_material("al5083")   # the material constants the laws read (molar mass, melt law) when not given
 AL = dict(M_g_per_mol=26.9815, rho0_g_per_cc=2.668, G0_GPa=28.0, alpha=0.23, T_melt_K=893.0)
 PTW_SETS = [
     dict(theta=0.025, p=2.0, s0=0.0085, sinf=0.00055, kappa=0.11, gamma=1e-5, y0=0.0001, yinf=0.00009999,
@@ -168,7 +170,7 @@ def grid_error(law_name, sets, closed, states) -> float:
     states = list(states)
     for values in sets:
         for rate, T, P, eta in states:
-            got = flow_stress_curve(law, values, STRAINS, rate, T, P, eta)
+            got = flow_stress_curve(law, values, STRAINS, rate, T, P, eta, material=AL5083)
             worst = max(worst, relative_error(got, closed(values, STRAINS, rate, T, P, eta)))
     return worst
 
@@ -206,7 +208,7 @@ def test_steinberg_guinan_shear_modulus_against_its_closed_form():
     worst = 0.0
     for values in SG_SETS:
         for T, P, eta in itertools.product(TEMPERATURES + [1150.0, 1300.0], PRESSURES, DENSITY_RATIOS):
-            worst = max(worst, relative_error(shear_modulus_gpa(law, values, T, P, eta), sg_shear(values, P, T, eta)))
+            worst = max(worst, relative_error(shear_modulus_gpa(law, values, T, P, eta, material=AL5083), sg_shear(values, P, T, eta)))
     assert worst <= RTOL
 
 
@@ -226,14 +228,14 @@ def test_conventions_at_the_edges():
     """Zero rate, zero temperature and melt: finite, and the documented limits."""
     ptw = get_law("ptw")
     values = PTW_SETS[0]
-    quasi_static = flow_stress_curve(ptw, values, STRAINS, 0.0, 298.0)
-    slow = flow_stress_curve(ptw, values, STRAINS, 1e-290, 298.0)   # erf(kappa T^ ln(1/r)) = 1
+    quasi_static = flow_stress_curve(ptw, values, STRAINS, 0.0, 298.0, material=AL5083)
+    slow = flow_stress_curve(ptw, values, STRAINS, 1e-290, 298.0, material=AL5083)   # erf(kappa T^ ln(1/r)) = 1
     assert np.allclose(quasi_static, slow, rtol=1e-6) and np.all(quasi_static > 0)
-    assert np.all(np.isfinite(flow_stress_curve(ptw, values, STRAINS, 1e3, 0.0)))
-    assert np.all(flow_stress_curve(ptw, values, STRAINS, 1e3, 893.0) == 0.0)
+    assert np.all(np.isfinite(flow_stress_curve(ptw, values, STRAINS, 1e3, 0.0, material=AL5083)))
+    assert np.all(flow_stress_curve(ptw, values, STRAINS, 1e3, 893.0, material=AL5083) == 0.0)
     za = ZA_SETS[0]
-    assert np.allclose(flow_stress_curve(get_law("za"), za, STRAINS, 0.0, 298.0), za["C0_MPa"], rtol=1e-14, atol=0)
-    assert np.all(flow_stress_curve(get_law("sg"), SG_SETS[0], STRAINS, 1.0, 1220.0) == 0.0)
+    assert np.allclose(flow_stress_curve(get_law("za"), za, STRAINS, 0.0, 298.0, material=AL5083), za["C0_MPa"], rtol=1e-14, atol=0)
+    assert np.all(flow_stress_curve(get_law("sg"), SG_SETS[0], STRAINS, 1.0, 1220.0, material=AL5083) == 0.0)
 
 
 # ---------------------------------------------------------------------------------------------- 3. second checks
@@ -257,7 +259,7 @@ def test_ptw_hardening_integrates_its_differential_law(values):
         solution = solve_ivp(slope, (0.0, STRAINS[-1]), [tau_y], method="DOP853", t_eval=STRAINS, rtol=1e-13,
                              atol=1e-18)
         G_MPa = 1e3 * values["G0_GPa"] * (1 - values["alpha"] * T / values["T_melt_K"])
-        worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, rate, T), 2 * G_MPa * solution.y[0]))
+        worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, rate, T, material=AL5083), 2 * G_MPa * solution.y[0]))
     assert worst <= 1e-9
 
 
@@ -265,7 +267,7 @@ def test_steinberg_guinan_modulus_and_melt_against_their_definitions():
     """G'_P = dG/dP and G'_T = dG/dT at (0, 300 K, eta = 1); d ln T_m / d ln eta = 2 (gamma(eta) - 1/3)
     with gamma(eta) = gamma0 - a (1 - 1/eta) (the Lindemann law SG integrate), by central differences."""
     for values in SG_SETS:
-        params = code_parameters(get_law("sg"), values)
+        params = code_parameters(get_law("sg"), values, material=AL5083)
         dP, dT = 1e-6, 1e-3                              # Mbar, K
         dG_dP = (steinberg_guinan_shear_modulus(params, dP, 300.0, 1.0)
                  - steinberg_guinan_shear_modulus(params, -dP, 300.0, 1.0)) / (2 * dP)
@@ -318,7 +320,7 @@ def test_ptw_against_impala(impala_functions):
                                         matomic=_array(values["M_g_per_mol"] * 6.022e23 / Avogadro, size),
                                         shear=G, eps=STRAINS.copy(), T=_array(T, size),
                                         Tmelt=_array(values["T_melt_K"], size))
-            worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, rate, T), impala * 1e5))
+            worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, rate, T, material=AL5083), impala * 1e5))
     assert worst <= 1e-10
 
 
@@ -337,7 +339,7 @@ def test_steinberg_guinan_against_impala(impala_functions):
                                          _array(values["n"], size), _array(values["Ymax_GPa"], size),
                                          _array(values["G0_GPa"], size), _array(values.get("eps_i", 0.0), size),
                                          G, STRAINS.copy(), _array(T, size), _array(T_melt, size))
-            worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, 1.0, T), impala * 1e3))
+            worst = max(worst, relative_error(flow_stress_curve(law, values, STRAINS, 1.0, T, material=AL5083), impala * 1e3))
     assert worst <= 1e-10
 
 
@@ -350,7 +352,7 @@ def _box_draws(name: str, count: int, rng, **ranges) -> list[tuple[dict, tuple]]
         values = {k: rng.uniform(b.low, b.high) for k, b in box.items()}
         values.update({k: rng.uniform(low, high) for k, (low, high) in ranges.items()})
         try:
-            sets.append((values, code_parameters(law, values)))
+            sets.append((values, code_parameters(law, values, material=AL5083)))
         except InputError:
             continue
     return sets
@@ -442,7 +444,7 @@ def test_declarations_and_boxes_agree():
     for name, law in LAWS.items():
         assert len(set(law.names())) == len(law.params)
         assert [p.field for p in law.params] == list(law.code_type._fields)
-        calibrated = [p.name for p in law.params if p.default is None]
+        calibrated = [p.name for p in law.params if p.default is None and p.material is None]
         assert set(calibrated) <= set(boxes[name]), name          # every calibrated parameter has a box
         for param in law.params:                                  # names carry their unit
             assert param.unit == "-" or param.name.endswith(UNIT_SUFFIX[param.unit]), param.name
@@ -452,24 +454,26 @@ def test_nominal_values_give_a_positive_flow_stress():
     boxes = load_boxes()
     for name in ("johnson-cook", "steinberg-guinan"):
         values = {k: b.nominal for k, b in boxes[name].items()}
-        stress = flow_stress_curve(get_law(name), values, STRAINS, 1e5, 310.0, 2.0, 1.02)
+        stress = flow_stress_curve(get_law(name), values, STRAINS, 1e5, 310.0, 2.0, 1.02, material=AL5083)
         assert np.all(np.isfinite(stress)) and np.all(stress > 0) and np.all(np.diff(stress) >= 0)
 
 
 def test_unit_conversions():
-    jc = code_parameters(get_law("jc"), dict(A_MPa=270, B_MPa=470, C=0.01, n=0.6, m=1.2))
+    jc = code_parameters(get_law("jc"), dict(A_MPa=270, B_MPa=470, C=0.01, n=0.6, m=1.2), material=AL5083)
     assert jc.A == pytest.approx(0.0027) and jc.rate_ref == pytest.approx(1e-6)
-    sg = code_parameters(get_law("sg"), SG_SETS[0])
+    sg = code_parameters(get_law("sg"), SG_SETS[0], material=AL5083)
     assert sg.G0 == pytest.approx(0.276) and sg.Y0 == pytest.approx(0.0029)
 
 
 # ---------------------------------------------------------------------------------------------- CLI
 JC_ARGS = ["--param", "A_MPa=270", "--param", "B_MPa=470", "--param", "C=0.0105", "--param", "n=0.6",
            "--param", "m=1.2"]
+AL5083_ARGS = ["--material", "al5083"]      # T_ref_K, T_melt_K and the reference rate of Johnson-Cook
 
 
 def test_cli_prints_a_table(capsys):
-    assert main(["flow-stress", "--model", "jc", *JC_ARGS, "--strain-rate", "1e5", "--temperature", "310"]) == 0
+    assert main(["flow-stress", "--model", "jc", *JC_ARGS, *AL5083_ARGS, "--strain-rate", "1e5", "--temperature",
+                 "310"]) == 0
     rows = [line.split() for line in capsys.readouterr().out.splitlines() if not line.startswith(("#", " plastic"))]
     rows = [r for r in rows if r and r[0] != "plastic_strain"]
     strains = np.array([float(r[0]) for r in rows])
@@ -501,9 +505,9 @@ def test_cli_errors_are_one_line(capsys, argv, message):
 
 @pytest.mark.parametrize("temperature, molten", [(310.0, False), (893.0, True), (3000.0, True)])
 def test_cli_says_when_the_state_is_molten(capsys, temperature, molten):
-    """Johnson-Cook's flow stress is zero at and above T_melt_K (893 K by default): the table says why."""
-    assert main(["flow-stress", "--model", "jc", *JC_ARGS, "--strain-rate", "1e5", "--temperature", str(temperature),
-                 "--points", "3"]) == 0
+    """Johnson-Cook's flow stress is zero at and above T_melt_K (Al-5083's 893 K): the table says why."""
+    assert main(["flow-stress", "--model", "jc", *JC_ARGS, *AL5083_ARGS, "--strain-rate", "1e5", "--temperature",
+                 str(temperature), "--points", "3"]) == 0
     out = capsys.readouterr().out
     note = f"# molten: T {temperature:g} K is at or above the law's melting temperature 893 K"
     assert (note in out) == molten

@@ -18,10 +18,12 @@ from shockcal.emulator.yield_input import YieldInput
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws import LAWS, flow_stress_curve, yield_stress_MPa
 from shockcal.hydro.laws.boxes import load_boxes
+from shockcal.hydro.material_library import load_material
 from shockcal.study.adapters import emulator_spec, study_design
 from shockcal.study.validate import validate_config
 
 SHOTS = ["104S", "105S", "106S"]
+AL5083 = load_material("al5083")
 
 
 def _with(config: dict, model: str, **emulator) -> dict:
@@ -39,19 +41,21 @@ def test_yield_stress_is_the_laws_flow_stress_at_zero_plastic_strain(model):
     rng = np.random.default_rng(7)
     values = {name: rng.uniform(b.low, b.high, 20) for name, b in box.items()}
     for rate, temperature in [(1.0e5, 298.0), (1.0e3, 600.0)]:
-        stress = yield_stress_MPa(law, values, rate, temperature)
-        single = [flow_stress_curve(law, {k: v[i] for k, v in values.items()}, [0.0], rate, temperature)[0]
+        stress = yield_stress_MPa(law, values, rate, temperature, material=AL5083)
+        single = [flow_stress_curve(law, {k: v[i] for k, v in values.items()}, [0.0], rate, temperature, material=AL5083)[0]
                   for i in range(20)]
         np.testing.assert_allclose(stress, single, rtol=1e-12, atol=0)
         assert np.all(stress > 0)
 
 
 def test_spec_gets_the_yield_input_for_the_listed_laws_only(paper_config):
-    """PTW's spec gets ln Y at 1e5/s and material.T_ref_K over its 13 parameters; Johnson-Cook's and
-    Steinberg-Guinan's (not listed) none, nor PTW's with `models: []`."""
+    """PTW's spec gets ln Y at 1e5/s and material.T_ref_K over its 13 parameters, with the material's
+    molar mass, density and melt temperature; Johnson-Cook's and Steinberg-Guinan's (not listed) none, nor
+    PTW's with `models: []`."""
     config = _with(paper_config, "ptw")
     spec = emulator_spec(config, SHOTS)
-    assert spec.yield_input == YieldInput("ptw", tuple(spec.shots["104S"].strength_inputs), 1.0e5, 298.0)
+    constants = {"M_g_per_mol": 26.9815, "rho0_g_per_cc": 2.668, "T_melt_K": 893.0}
+    assert spec.yield_input == YieldInput("ptw", tuple(spec.shots["104S"].strength_inputs), 1.0e5, 298.0, constants)
     assert len(spec.yield_input.columns) == 13
     config["material"]["T_ref_K"] = 310.0
     assert emulator_spec(config, SHOTS).yield_input.temperature_K == 310.0
@@ -119,7 +123,8 @@ def test_the_yield_input_lets_the_emulator_see_a_switch_in_the_yield(paper_confi
 
 def test_only_the_listed_laws_emulate_stage_reads_the_yield_input(paper_config):
     """A Johnson-Cook study's emulate slice is what it was before the key existed (no job reruns); PTW's
-    has the key and material.T_ref_K, and the spec built from either slice is the full config's."""
+    has the key, material.T_ref_K and the material constants of PTW's yield, and the spec built from either
+    slice is the full config's."""
     from shockcal.study.stages import stage_config
 
     jc = stage_config(paper_config, "emulate")
@@ -128,5 +133,6 @@ def test_only_the_listed_laws_emulate_stage_reads_the_yield_input(paper_config):
     assert stage_config(paper_config, ["emulate", "simulate"], "104S")["material"]["T_ref_K"] == 298.0
     ptw = _with(paper_config, "ptw")
     sliced = stage_config(ptw, "emulate")
-    assert sliced["emulator"]["yield_input"]["models"] == ["ptw"] and sliced["material"] == {"T_ref_K": 298.0}
+    assert sliced["emulator"]["yield_input"]["models"] == ["ptw"] and sliced["material"] == {
+        "T_ref_K": 298.0, "molar_mass_g_per_mol": 26.9815, "rho0_g_cc": 2.668, "T_melt_K": 893.0}
     assert emulator_spec(sliced, SHOTS) == emulator_spec(ptw, SHOTS)

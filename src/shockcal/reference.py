@@ -1,8 +1,10 @@
-"""Where the paper's data release lives (measured records, published features, FLAG features).
+"""Where the tests and benchmarks find the paper's data release (its design and FLAG features).
 
 The data is never copied into the project. It is looked up in $SHOCKCAL_REFERENCE_DATA, else in
 `../shared/data/al5083` beside the repository (or beside the working directory). Tests and
-benchmarks that need it call `reference_dir()` and skip, saying so, when it returns None.
+benchmarks that need it call `reference_dir()` and skip, saying so, when it returns None. A study
+never reads this default: its archive paths' `{reference_data}` is $SHOCKCAL_REFERENCE_DATA or the
+config's `simulator.archive.reference_data` (`shockcal.study.simulator.resolve_path`).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ from shockcal.cli import add_command
 
 EXAMPLE_FLOW_STRESS = """\
 shockcal flow-stress --model johnson-cook --param A_MPa=335 --param B_MPa=425 --param C=0.0335 \\
-    --param n=0.42 --param m=1.225 --strain-rate 1e5 --temperature 298"""
+    --param n=0.42 --param m=1.225 --material al5083 --strain-rate 1e5 --temperature 298"""
 
 
 def register(subparsers) -> None:
@@ -15,12 +15,16 @@ def register(subparsers) -> None:
                     description="Flow stress (MPa) of a strength law (johnson-cook, steinberg-guinan, ptw, "
                                 "zerilli-armstrong) against equivalent plastic strain, at a constant strain rate, "
                                 "temperature, pressure and density ratio. Parameters by their unit-suffixed names "
-                                "(shockcal.hydro.laws.declarations), e.g. --param A_MPa=270; material constants have "
-                                "defaults. At or above the law's melting temperature the flow stress is zero, and the "
+                                "(shockcal.hydro.laws.declarations), e.g. --param A_MPa=270; the law's material "
+                                "constants (melt temperature, density, molar mass) from --material unless given by "
+                                "--param. At or above the law's melting temperature the flow stress is zero, and the "
                                 "table says so.")
     p.add_argument("--model", required=True,
                    help="johnson-cook (jc), steinberg-guinan (sg), ptw, zerilli-armstrong (za)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a parameter (repeat)")
+    p.add_argument("--material", metavar="NAME",
+                   help="a library material (shockcal materials) giving the law's material constants; without it, "
+                        "give them by --param")
     p.add_argument("--strain-rate", type=float, required=True, help="equivalent strain rate (1/s)")
     p.add_argument("--temperature", type=float, required=True, help="temperature (K)")
     p.add_argument("--pressure", type=float, default=0.0, help="pressure (GPa, positive in compression; default 0)")
@@ -55,10 +59,19 @@ def run(args) -> int:
     import numpy as np
 
     from shockcal.errors import InputError
-    from shockcal.hydro.laws import flow_stress_curve, get_law, melt_temperature_K, shear_modulus_gpa
+    from shockcal.hydro.laws import (
+        check_given,
+        flow_stress_curve,
+        get_law,
+        law_values,
+        melt_temperature_K,
+        shear_modulus_gpa,
+    )
+    from shockcal.hydro.material_library import load_material
 
     law = get_law(args.model)
-    values = parse_params(args.param)
+    given = parse_params(args.param)
+    check_given(law, given)
     state = {"--strain-rate": args.strain_rate, "--temperature": args.temperature, "--pressure": args.pressure,
              "--density-ratio": args.density_ratio, "--max-strain": args.max_strain}
     for option, value in state.items():
@@ -71,6 +84,7 @@ def run(args) -> int:
         raise InputError(f"--density-ratio: {args.density_ratio} is not positive")
     if args.points < 2:
         raise InputError(f"--points: {args.points} is fewer than 2")
+    values = law_values(law, given, None if args.material is None else load_material(args.material))
     strains = np.linspace(0.0, args.max_strain, args.points)
     stress = flow_stress_curve(law, values, strains, args.strain_rate, args.temperature, args.pressure,
                                args.density_ratio)

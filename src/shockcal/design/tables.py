@@ -170,7 +170,8 @@ class ShotMapping:
     def parameters(self, row) -> ShotParameters | LawShotParameters:
         """One design row (a mapping of input name to value) as this shot's hydrocode inputs. Johnson-Cook's
         Table IV values reach the kernel unconverted (`ShotParameters.from_table_iv`); another law's go
-        through `LawShotParameters` (InputError for a row that breaks the law's constraints)."""
+        through `LawShotParameters` (its material constants and constraints are checked by `run_shot`, with
+        the run's material)."""
         velocity = float(row[self.velocity_input])
         shear = float(sum(row[k] for k in self.shear_modulus_inputs)) if self.shear_modulus_inputs else None
         if self.model == "johnson-cook":

@@ -9,7 +9,7 @@ one more input, turns the edge into a coordinate: v_elastic is a smooth function
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -20,19 +20,23 @@ from shockcal.hydro.laws import get_law, yield_stress_MPa
 class YieldInput:
     """ln(Y / 1 MPa), Y the flow stress of strength law `model` at zero plastic strain, equivalent strain rate
     `strain_rate_per_s` (1/s) and temperature `temperature_K` (K) (`shockcal.hydro.laws.yield_stress_MPa`),
-    from the design columns `columns`: the law's parameters by their declared names and units."""
+    from the design columns `columns`: the law's parameters by their declared names and units, and the law's
+    material constants `constants` (by parameter name: PTW's M_g_per_mol, rho0_g_per_cc, T_melt_K, from the
+    study's material, `shockcal.study.strength_config.material_constants`)."""
 
     model: str
     columns: tuple[str, ...]
     strain_rate_per_s: float
     temperature_K: float
+    constants: dict[str, float] = field(default_factory=dict)
 
     name = "ln_yield_MPa"
 
     def values(self, inputs) -> np.ndarray:
         """The input at every row of `inputs` (a mapping or DataFrame of the design columns)."""
-        stress = yield_stress_MPa(get_law(self.model), {c: np.asarray(inputs[c], dtype=float) for c in self.columns},
-                                  self.strain_rate_per_s, self.temperature_K)
+        columns = {c: np.asarray(inputs[c], dtype=float) for c in self.columns}
+        stress = yield_stress_MPa(get_law(self.model), {**self.constants, **columns}, self.strain_rate_per_s,
+                                  self.temperature_K)
         if not np.all(stress > 0):
             bad = int(np.argmin(stress > 0))
             raise ValueError(f"{self.model}: yield stress {stress[bad]:g} MPa at row {bad} is not positive; "
@@ -44,4 +48,5 @@ class YieldInput:
 
     @classmethod
     def from_json(cls, d: dict) -> YieldInput:
-        return cls(str(d["model"]), tuple(d["columns"]), float(d["strain_rate_per_s"]), float(d["temperature_K"]))
+        return cls(str(d["model"]), tuple(d["columns"]), float(d["strain_rate_per_s"]), float(d["temperature_K"]),
+                   {str(k): float(v) for k, v in d.get("constants", {}).items()})

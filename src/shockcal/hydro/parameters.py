@@ -26,12 +26,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from shockcal.errors import InputError
-from shockcal.hydro.laws import code_parameters, get_law
+from shockcal.hydro.laws import check_given, code_parameters, get_law
 from shockcal.hydro.rules import check_fields
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA, MBAR_TO_MPA
+
+if TYPE_CHECKING:
+    from shockcal.hydro.settings import MaterialProperties
 
 # The Johnson-Cook inputs every shot shares (SPEC section 3), as the design tables name them.
 JOHNSON_COOK_INPUTS = ("A", "B", "C", "n", "m")
@@ -98,13 +101,16 @@ class ShotParameters:
 @dataclass(frozen=True)
 class LawShotParameters:
     """The inputs of one run of one shot under any strength law, in user units; checked on creation
-    (InputError naming the model or parameter).
+    (InputError naming the model or parameter), against the law's constraints when the run's material
+    fills in its constants (`law_parameters`).
 
     Args:
         model: the law (`shockcal.hydro.laws.get_law`: johnson-cook, steinberg-guinan, ptw,
             zerilli-armstrong, or an alias jc, sg, za).
         values: the law's parameters by their declared names, in the units the names carry (Y0_GPa,
-            C0_MPa, ...); declared defaults fill the material constants left out.
+            C0_MPa, ...); the run's material fills the material constants left out (PTW's molar mass,
+            density and melt temperature, Steinberg-Guinan's melt law: `shockcal.hydro.laws.law_values`),
+            declared defaults the law's conventions (eps_i, Zerilli-Armstrong's reference rate).
         velocity_m_s: impact velocity of the flyer (m/s).
         shear_modulus_GPa: G of flyer and target (GPa) for laws without a shear-modulus law
             (Johnson-Cook, Zerilli-Armstrong); None for Steinberg-Guinan and PTW, whose G(P, T) is theirs.
@@ -117,7 +123,7 @@ class LawShotParameters:
 
     def __post_init__(self):
         law = get_law(self.model)
-        code_parameters(law, self.values)
+        check_given(law, self.values)
         check_fields(self, {"velocity_m_s": "impact_velocity_m_s"})
         if law.shear_modulus is not None and self.shear_modulus_GPa is not None:
             raise InputError(f"{law.name}: shear_modulus_GPa given, but the law computes G(P, T) itself "
@@ -127,9 +133,11 @@ class LawShotParameters:
                              "it is not given")
         check_fields(self, {"shear_modulus_GPa": "positive"})
 
-    def law_parameters(self):
-        """The law's named tuple in code units (Mbar, K, 1/us, g/cc)."""
-        return code_parameters(get_law(self.model), self.values)
+    def law_parameters(self, material: MaterialProperties):
+        """The law's named tuple in code units (Mbar, K, 1/us, g/cc), the material constants not in `values`
+        from `material`; InputError naming a material key the law needs and `material` lacks, or a broken
+        constraint."""
+        return code_parameters(get_law(self.model), self.values, material)
 
     def shear_modulus_Mbar(self) -> float:
         """The constant G in Mbar, NaN (unused) for laws with their own shear-modulus law."""

@@ -64,6 +64,11 @@ class MaterialProperties:
         T_melt_K: melting temperature (K), where T* = 1 and the strength vanishes.
         cv_J_per_kg_K: specific heat (J/kg/K).
         strain_rate_ref_per_s: the Johnson-Cook reference strain rate eps0 (1/s).
+        molar_mass_g_per_mol: molar mass (g/mol; an alloy's mean atomic mass), which PTW's strain-rate
+            scale reads; None: not given (a law that needs it is refused, naming it).
+        melt_T_m0_K, melt_gamma0, melt_a: Steinberg's melt law T_m = T_m0 exp(2a(1 - 1/eta))
+            eta^(2(gamma0 - a - 1/3)) (Steinberg-Guinan's): melt temperature at eta = 1 (K), its Grueneisen
+            coefficient and first-order volume coefficient (-); None: not given.
     """
 
     rho0_g_cc: float
@@ -75,11 +80,17 @@ class MaterialProperties:
     T_melt_K: float
     cv_J_per_kg_K: float
     strain_rate_ref_per_s: float = 1.0
+    molar_mass_g_per_mol: float | None = None
+    melt_T_m0_K: float | None = None
+    melt_gamma0: float | None = None
+    melt_a: float | None = None
 
     def __post_init__(self):
         check_fields(self, {"rho0_g_cc": "positive", "c1_Mbar": "positive", "c2_Mbar": "finite", "c3_Mbar": "finite",
                             "gamma0": "nonnegative", "T_ref_K": "positive", "T_melt_K": "positive",
-                            "cv_J_per_kg_K": "positive", "strain_rate_ref_per_s": "positive"})
+                            "cv_J_per_kg_K": "positive", "strain_rate_ref_per_s": "positive",
+                            "molar_mass_g_per_mol": "positive", "melt_T_m0_K": "positive",
+                            "melt_gamma0": "nonnegative", "melt_a": "finite"})
         problem = melting_problem(self.T_ref_K, self.T_melt_K)
         if problem:
             raise InputError(f"MaterialProperties: {problem}")

@@ -2,10 +2,11 @@
 
     from shockcal.hydro import Geometry, ShotParameters, run_shot
     params = ShotParameters(A_MPa=335, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
-    result = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=3.0))
+    result = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=3.0), load_material("al5083"))
 
 `result.t_us` and `result.v_m_s` are the target's free-surface velocity history (us, m/s). Any
-strength law: `run_shot(LawShotParameters("sg", {...}, velocity_m_s=204), geometry)`.
+strength law: `run_shot(LawShotParameters("sg", {...}, velocity_m_s=204), geometry, material)`, the law's
+material constants (density, molar mass, melt temperature) from `material` unless `params` gives them.
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from shockcal.hydro.material_library import load_material
 from shockcal.hydro.parameters import LawShotParameters, ShotParameters
 from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.solver import simulate
@@ -51,7 +51,7 @@ class RunResult:
 STUDY_NUMERICS = HydroSettings()
 
 
-def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties | None = None,
+def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, material: MaterialProperties,
              settings: HydroSettings = STUDY_NUMERICS) -> RunResult:
     """Simulate one symmetric shot to `geometry.end_us` (or its end after the free surface's rise).
 
@@ -60,8 +60,9 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
             or any strength law's (`LawShotParameters`).
         geometry: flyer and target thickness (mm), the simulated time (us) and the plates' initial
             temperature (K; hot plates start expanded at zero pressure, `MaterialProperties.initial_state`).
-        material: EOS and thermal constants of flyer and target; None: the material library's `al5083`
-            (`shockcal.hydro.material_library.load_material`, the paper's Table II).
+        material: EOS and thermal constants of flyer and target (`shockcal.hydro.material_library.load_material`
+            gives a library entry's: `load_material("al5083")`, the paper's Table II), and the constants of
+            `params`' law it leaves out (`shockcal.hydro.laws.law_values`).
         settings: mesh, output sampling, artificial viscosity and time stepping (default the study's).
 
     Returns:
@@ -69,8 +70,6 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
         the impact's kinetic energy, the plates' initial internal energy left out). A numerical failure is
         a result with status "failed" and a reason naming the cell and time, never an exception.
     """
-    if material is None:
-        material = load_material("al5083")
     nf, nt = settings.cells(geometry.flyer_mm, "Geometry.flyer_mm"), settings.cells(geometry.target_mm, "Geometry.target_mm")
     dt_out = settings.output_dt_us()
     t_out = np.arange(int(round(geometry.end_us / dt_out)) + 1) * dt_out
@@ -103,9 +102,11 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
 
 def kernel_strength(params: ShotParameters | LawShotParameters, material: MaterialProperties):
     """(impact velocity in cm/us, the kernel's strength tuple): `Strength` (Johnson-Cook with the
-    material's T_ref, T_melt and reference rate, floored return) or `LawStrength` (any law)."""
+    material's T_ref, T_melt and reference rate, floored return) or `LawStrength` (any law, its material
+    constants from `material` unless given)."""
     if isinstance(params, LawShotParameters):
-        return params.velocity_m_s / CM_US_TO_M_S, LawStrength(params.law_parameters(), params.shear_modulus_Mbar())
+        return params.velocity_m_s / CM_US_TO_M_S, LawStrength(params.law_parameters(material),
+                                                               params.shear_modulus_Mbar())
     inputs = params.table_iv()
     return inputs.velocity_cm_us, Strength(inputs.shear_modulus_Mbar, inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n,
                                            inputs.m, material.rate_ref_per_us())

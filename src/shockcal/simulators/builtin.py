@@ -54,7 +54,7 @@ def simulate_design(design: pd.DataFrame, mapping: ShotMapping, geometry: Geomet
         row = {"run": int(record["run"]), "shot": shot, **{k: float(record[k]) for k in inputs},
                "impact_velocity_m_s": np.nan, "shear_modulus_GPa": np.nan}
         try:
-            params = mapping.parameters(record)        # InputError: a row that breaks the law's constraints
+            params = mapping.parameters(record)        # InputError (here or in run_shot): a row that breaks the law
             row["impact_velocity_m_s"] = params.velocity_m_s
             row["shear_modulus_GPa"] = np.nan if params.shear_modulus_GPa is None else params.shear_modulus_GPa
             result = run_shot(params, geometry, material, settings)

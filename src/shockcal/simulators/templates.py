@@ -33,7 +33,7 @@ _SHOT = {"run": "id", "shot": "name", "velocity_m_s": "m/s", "velocity_cm_us": "
          "target_mm": "mm", "initial_temperature_K": "K", "end_time_us": "us"}
 _MODULUS = {"shear_modulus_GPa": "GPa", "shear_modulus_Mbar": "Mbar"}
 _SUFFIX_UNITS = {"_Mbar": "Mbar", "_GPa": "GPa", "_MPa": "MPa", "_g_cc": "g/cc", "_J_per_kg_K": "J/kg/K", "_K": "K",
-                 "_per_s": "1/s", "_um": "um", "_ns": "ns", "_us": "us"}
+                 "_per_s": "1/s", "_g_per_mol": "g/mol", "_um": "um", "_ns": "ns", "_us": "us"}
 COMMAND_ONLY = {"python": "path", "study_dir": "path", "run_dir": "path"}
 
 

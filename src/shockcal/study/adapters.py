@@ -29,7 +29,7 @@ from shockcal.study.config import (
     velocity_box_m_s,
     wave_sizes,
 )
-from shockcal.study.strength_config import DEFAULT_MODEL, strength_model, strength_parameters
+from shockcal.study.strength_config import DEFAULT_MODEL, material_constants, strength_model, strength_parameters
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -148,7 +148,7 @@ def emulator_settings(config: dict) -> EmulatorSettings:
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
     """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
     inputs eps^n and T*^m for Johnson-Cook only; the yield input for the laws of `emulator.yield_input`,
-    at material.T_ref_K)."""
+    at material.T_ref_K with the law's material constants)."""
     from shockcal.emulator.study_emulator import POWER_INPUTS, EmulatorSpec
     from shockcal.emulator.yield_input import YieldInput
 
@@ -160,8 +160,9 @@ def emulator_spec(config: dict, shots) -> EmulatorSpec:
     yield_section = section.get("yield_input")    # left out of the stage's slice for a law it does not list
     yield_input = None
     if yield_section is not None and model in yield_section["models"]:
-        yield_input = YieldInput(model, tuple(strength_parameters(config)), yield_section["strain_rate_per_s"],
-                                 config["material"]["T_ref_K"])
+        columns = tuple(strength_parameters(config))
+        yield_input = YieldInput(model, columns, yield_section["strain_rate_per_s"], config["material"]["T_ref_K"],
+                                 material_constants(config, model, columns))
     return EmulatorSpec(section["structure"], mappings, prior_bounds(config), powers, emulator_settings(config),
                         yield_input=yield_input)
 
@@ -360,13 +361,14 @@ def archive_source(config: dict, shot: str):
     from shockcal.study.simulator import resolve_path
 
     section = config["simulator"]["archive"]
-    design = resolve_path(section["design"], "simulator.archive.design")
+    design = resolve_path(section["design"], "simulator.archive.design", section)
     if shot in section.get("features", {}):
-        return ArchiveSource(design, features=resolve_path(section["features"][shot], f"simulator.archive.features.{shot}"))
+        return ArchiveSource(design, features=resolve_path(section["features"][shot], f"simulator.archive.features.{shot}",
+                                                           section))
     if shot not in section.get("traces", {}):
         raise ConfigError(f"simulator.archive: no runs of {shot} (neither features.{shot} nor traces.{shot}); an archive "
                           "holds the training runs of the study's shots only")
     pattern = section["traces"][shot]
-    resolved = resolve_path(pattern, f"simulator.archive.traces.{shot}")
+    resolved = resolve_path(pattern, f"simulator.archive.traces.{shot}", section)
     return ArchiveSource(design, traces=str(resolved), trace=OutputSpec(**{**section.get("trace", {}), "kind": "trace",
                                                                             "file": Path(pattern).name}))

@@ -28,8 +28,9 @@ PLACEHOLDERS = {"shots": "<shot>", "inputs": "<input>", "observed.features": "<s
                 "simulator.archive.traces": "<shot>", "study.report_notes": "<caption>",
                 "study.reference_sets[].values": "<parameter>"}
 # unit suffixes of key names (shockcal's "units in names"), longest match first
-UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K"), ("_g_cc", "g/cc"), ("_Mbar", "Mbar"), ("_mm", "mm"),
-                 ("_um", "um"), ("_us", "us"), ("_ns", "ns"), ("_K", "K"))
+UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K"), ("_g_cc", "g/cc"),
+                 ("_g_per_mol", "g/mol"), ("_Mbar", "Mbar"), ("_mm", "mm"), ("_um", "um"), ("_us", "us"), ("_ns", "ns"),
+                 ("_K", "K"))
 # STAGE_KEYS path segments that stand for any key, and what they say about which jobs rerun
 WILDCARDS = {"*": "", "{shot}": "its shot", "{shot_inputs}": "shots that read it"}
 # the figure catalogue lists the figures of a config's shots: three stand-ins give every figure

@@ -1,7 +1,8 @@
 """The config's `simulator` section read: its kind, and the archive's paths, runs and design (docs/simulators.md).
 
 `simulator_kind` is "builtin" when the section is left out. An archive path may start with
-`{reference_data}`, the paper's data release (`shockcal.reference.reference_dir`). The section's rules
+`{reference_data}`: $SHOCKCAL_REFERENCE_DATA, else the folder `simulator.archive.reference_data` names
+(`resolve_path`). The section's rules
 are in `shockcal.study.simulator_rules`.
 """
 
@@ -21,18 +22,24 @@ def simulator_kind(config: dict) -> str:
     return (config.get("simulator") or {}).get("kind", "builtin")
 
 
-def resolve_path(path: str, where: str) -> Path:
-    """`path` with a leading {reference_data} replaced by the reference-data folder; a ConfigError naming
-    `where` when that folder is not on this machine."""
+def resolve_path(path: str, where: str, section: dict) -> Path:
+    """`path` with a leading {reference_data} replaced by $SHOCKCAL_REFERENCE_DATA, else by the archive
+    `section`'s `reference_data` folder; a ConfigError naming `where` when neither names one, or the folder
+    does not exist."""
     if not path.startswith(REFERENCE_DATA):
         return Path(path)
-    from shockcal.reference import ENV_VAR, reference_dir
+    import os
 
-    folder = reference_dir()
-    if folder is None:
-        raise ConfigError(f"{where}: {path}: the reference data is not on this machine; set ${ENV_VAR} to its folder "
-                          "(the one holding design.csv)")
-    return folder / path[len(REFERENCE_DATA):].lstrip("/")
+    from shockcal.reference import ENV_VAR
+
+    folder = os.environ.get(ENV_VAR) or section.get("reference_data")
+    if not folder:
+        raise ConfigError(f"{where}: {path}: {REFERENCE_DATA} names no folder; set simulator.archive.reference_data "
+                          f"or ${ENV_VAR}")
+    if not Path(folder).is_dir():
+        raise ConfigError(f"{where}: {path}: the reference-data folder {folder} does not exist here; set "
+                          f"${ENV_VAR} or simulator.archive.reference_data to the folder holding the data")
+    return Path(folder) / path[len(REFERENCE_DATA):].lstrip("/")
 
 
 def archive_runs(config: dict) -> list[int]:
@@ -41,14 +48,14 @@ def archive_runs(config: dict) -> list[int]:
     from shockcal.io import integer_ids, read_table, require_columns
 
     section = config["simulator"]["archive"]
-    design_path = resolve_path(section["design"], "simulator.archive.design")
+    design_path = resolve_path(section["design"], "simulator.archive.design", section)
     design = read_table(design_path)
     require_columns(design, ["run"], f"simulator.archive.design ({design_path})")
     design_runs = set(integer_ids(design, "run", design_path)["run"])
     runs, first = None, None
     for shot, path in section.get("features", {}).items():
         key = f"simulator.archive.features.{shot}"
-        table = read_table(resolve_path(path, key))
+        table = read_table(resolve_path(path, key, section))
         require_columns(table, ["run"], f"{key} ({path})")
         ids = set(integer_ids(table, "run", path)["run"])
         outside = sorted(ids - design_runs)
@@ -67,7 +74,8 @@ def archive_runs(config: dict) -> list[int]:
 def archive_design(config: dict, load) -> tuple[pd.DataFrame, str]:
     """(the training design, where it came from): the archive's design rows that have runs, read by
     `load(path)` (the study's design loader, which checks the box)."""
-    path = resolve_path(config["simulator"]["archive"]["design"], "simulator.archive.design")
+    section = config["simulator"]["archive"]
+    path = resolve_path(section["design"], "simulator.archive.design", section)
     design = load(path)
     runs = archive_runs(config)
     return design[design["run"].isin(runs)].reset_index(drop=True), f"archive {path} ({len(runs)} runs)"

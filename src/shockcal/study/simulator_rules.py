@@ -60,7 +60,7 @@ def check_archive(config: dict, source: str) -> None:
     if config["design"].get("file"):
         raise ConfigError(f"{source}: design.file: the archive's design (simulator.archive.design) is the training "
                           "design; leave design.file out")
-    design_path = resolve_path(section["design"], f"{where}.design")
+    design_path = resolve_path(section["design"], f"{where}.design", section)
     if not design_path.is_file():
         raise ConfigError(f"{where}.design: {design_path} does not exist")
     for shot in config["shots"]:

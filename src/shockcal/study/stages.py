@@ -21,7 +21,7 @@ from collections.abc import Iterable, Iterator
 
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
-from shockcal.study.strength_config import strength_model
+from shockcal.study.strength_config import DEFAULT_MODEL, strength_model
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
@@ -108,10 +108,28 @@ def stage_config(config: dict, stages: str | Iterable[str], shot: str | None = N
     unknown = [stage for stage in stages if stage not in STAGE_KEYS]
     if unknown:
         raise ValueError(f"unknown stage {unknown[0]!r}; stages: {', '.join(STAGE_KEYS)}")
-    sliced = config_slice(config, [path for stage in stages for path in STAGE_KEYS[stage]], shot, "+".join(stages))
+    paths = [path for stage in stages for path in STAGE_KEYS[stage]] + _law_material_keys(config, stages)
+    sliced = config_slice(config, paths, shot, "+".join(stages))
     if "emulate" in stages:
         _drop_unread_yield_input(config, stages, sliced)
     return sliced
+
+
+def _law_material_keys(config: dict, stages: list[str]) -> list[str]:
+    """The material keys that the study's law (other than Johnson-Cook, whose constants _MATERIAL holds) reads
+    for the constants it does not calibrate (`shockcal.study.strength_config.material_constants`): in the slice
+    of the simulate stage, and of the emulate stage for a law with the yield input; none for another law, so
+    that a material key only PTW or Steinberg-Guinan reads reruns no other law's jobs."""
+    model = strength_model(config)
+    if model == DEFAULT_MODEL:
+        return []
+    yield_input = model in config["emulator"]["yield_input"]["models"]
+    if "simulate" not in stages and not ("emulate" in stages and yield_input):
+        return []
+    from shockcal.hydro.laws import get_law
+
+    return [f"material.{p.material}" for p in get_law(model).params
+            if p.material is not None and p.name not in config["inputs"]]
 
 
 def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> None:

@@ -5,7 +5,8 @@ With `strength.model` other than johnson-cook, `apply_strength_model` rewrites t
 input and, for a law without a shear-modulus law, each shot's modulus inputs, so that every stage
 reads its box, names and units from `inputs` as for Johnson-Cook; `strength.inputs` then holds the
 whole box, so the rewritten config validates to itself (the workflow's jobs read it again).
-Johnson-Cook configs are left alone.
+Johnson-Cook configs are left alone. A law's material constants (PTW's molar mass, density, melt
+temperature; Steinberg-Guinan's melt law) come from `material` (`material_constants`), unless boxed.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
-from shockcal.hydro.laws import flow_stress_curve, get_law
+from shockcal.hydro.laws import flow_stress_curve, get_law, law_values
 from shockcal.hydro.laws.boxes import load_boxes
 
 DEFAULT_MODEL = "johnson-cook"
@@ -52,7 +53,8 @@ def apply_strength_model(config: dict, source: str) -> None:
     drops Johnson-Cook's inputs the law does not have (a Johnson-Cook config's power, kept by an overlay that
     cannot delete it); a name the law has (Steinberg-Guinan's n) keeps its power. ConfigError naming the key:
     a parameter the law does not have, a missing bound, min >= max, an input that is neither the law's nor a
-    shot's, a box corner whose flow stress is negative or not finite."""
+    shot's, a material constant the law needs and `material` does not give, a box corner whose flow stress is
+    negative or not finite."""
     model = strength_model(config)
     if model == DEFAULT_MODEL:
         return
@@ -65,14 +67,14 @@ def apply_strength_model(config: dict, source: str) -> None:
                               f"(parameters: {', '.join(law.names())})")
     models_file = section.get("models_file", "config/models.yaml")
     file_box = _file_box(models_file, law.name, source) if any(
-        p.default is None and p.name not in given for p in law.params) else {}
+        _calibrated(p) and p.name not in given for p in law.params) else {}
     box = {}
     for param in law.params:
         if param.name in given:
             low, high, where = given[param.name]["min"], given[param.name]["max"], f"strength.inputs.{param.name}"
         elif param.name in file_box:
             low, high, where = file_box[param.name].low, file_box[param.name].high, f"{models_file}: {law.name}.{param.name}"
-        elif param.default is None:
+        elif _calibrated(param):
             raise ConfigError(f"{source}: strength.inputs.{param.name}: missing; {law.name} needs a box for it "
                               f"(give min and max, or a low/high in {models_file})")
         else:
@@ -80,12 +82,30 @@ def apply_strength_model(config: dict, source: str) -> None:
         if not low < high:
             raise ConfigError(f"{source}: {where}: min ({low}) must be below max ({high})")
         box[param.name] = {"min": float(low), "max": float(high), "unit": param.unit}
-    check_corners(law, box, source)
+    check_corners(law, box, material_constants(config, law.name, box, source), source)
     config["inputs"] = {**box, **_shot_inputs(config, law, given, source)}
     section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
     cube = config["calibration"]["cube_power"]
     config["calibration"]["cube_power"] = {k: v for k, v in cube.items()
                                            if k in config["inputs"] or k not in JOHNSON_COOK_INPUTS}
+
+
+def _calibrated(param) -> bool:
+    """A parameter that needs a box: neither a declared default nor a material constant."""
+    return param.default is None and param.material is None
+
+
+def material_constants(config: dict, model: str, boxed=(), source: str = "config") -> dict[str, float]:
+    """The material constants of law `model` that the study does not calibrate (not in `boxed`), by parameter
+    name, from the config's `material` (`shockcal.hydro.laws.law_values`, the one place they are filled); a
+    constant the material does not give is a ConfigError naming the material key."""
+    law = get_law(model)
+    boxed = [name for name in boxed if name in law.names()]
+    try:
+        filled = law_values(law, dict.fromkeys(boxed, 0.0), config["material"])
+    except InputError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+    return {p.name: filled[p.name] for p in law.params if p.material is not None and p.name not in boxed}
 
 
 def _file_box(path: str, law_name: str, source: str) -> dict:
@@ -119,8 +139,9 @@ def _shot_inputs(config: dict, law, given: dict, source: str) -> dict:
     return out
 
 
-def check_corners(law, box: dict, source: str) -> None:
-    """Every corner of the law's box (parameters outside the box at their defaults) must meet the law's
+def check_corners(law, box: dict, constants: dict, source: str) -> None:
+    """Every corner of the law's box (parameters outside the box at the material's `constants`, by name, and
+    their declared defaults) must meet the law's
     constraints (all linear: SG's Ymax >= Y0, PTW's ordering of s0, sinf, y0, yinf, y1, ...; so the
     whole box meets them), and give a finite, non-negative flow stress at CORNER_STATES: a ConfigError
     naming the corner otherwise."""
@@ -128,7 +149,7 @@ def check_corners(law, box: dict, source: str) -> None:
     if 2 ** len(names) > MAX_CORNERS:
         raise ConfigError(f"{source}: strength.inputs: {len(names)} boxed parameters; at most "
                           f"{MAX_CORNERS.bit_length() - 1} (the box's corners are checked)")
-    defaults = {p.name: p.default for p in law.params if p.default is not None}
+    defaults = {**{p.name: p.default for p in law.params if p.default is not None}, **constants}
     for corner in itertools.product(*((box[n]["min"], box[n]["max"]) for n in names)):
         values = {**defaults, **dict(zip(names, corner))}
         where = ", ".join(f"{n}={v:g}" for n, v in zip(names, corner))

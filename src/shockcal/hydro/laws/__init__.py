@@ -10,13 +10,16 @@ ignores what it does not depend on. Laws whose shear modulus varies also have
 `shear_modulus(law, P, T, eta) -> Mbar`. The laws: `johnson-cook` (today's hydrocode law, bit for
 bit), `steinberg-guinan`, `ptw` (Preston-Tonks-Wallace) and `zerilli-armstrong` (fcc). Their
 parameters, in user units with the conversion to code units, are declared in `declarations.py`;
-prior boxes for aluminium with sources in config/models.yaml (`boxes.py`). The solver calls them
-through `kernels.py` (`law_flow_stress`, `law_shear_modulus`); docs/strength_laws.md.
+those that are properties of the material (density, molar mass, melt temperature) come from the
+study's `MaterialProperties` through `law_values`, the one place that fills them; prior boxes for
+aluminium with sources in config/models.yaml (`boxes.py`). The solver calls them through
+`kernels.py` (`law_flow_stress`, `law_shear_modulus`); docs/strength_laws.md.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,10 +27,13 @@ from shockcal.errors import InputError
 from shockcal.hydro.laws.declarations import ALIASES, LAWS, Law, Param
 from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 
+if TYPE_CHECKING:
+    from shockcal.hydro.settings import MaterialProperties
+
 MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
 
-__all__ = ["LAWS", "Law", "Param", "code_parameters", "flow_stress_curve", "get_law", "melt_temperature_K",
-           "shear_modulus_gpa", "yield_stress_MPa"]
+__all__ = ["LAWS", "Law", "Param", "check_given", "code_parameters", "flow_stress_curve", "get_law", "law_values",
+           "melt_temperature_K", "shear_modulus_gpa", "yield_stress_MPa"]
 
 
 def get_law(name: str) -> Law:
@@ -38,9 +44,48 @@ def get_law(name: str) -> Law:
     return LAWS[key]
 
 
+def law_values(law: Law, values: Mapping, material: MaterialProperties | Mapping | None) -> dict:
+    """`values` (by parameter name) completed with the material's constants: each parameter declared with a
+    `material` field (PTW's M_g_per_mol, rho0_g_per_cc, T_melt_K; Steinberg-Guinan's melt law T_m0_K, gamma0,
+    a; Johnson-Cook's T_ref_K, T_melt_K, rate_ref_per_s) and not in `values` takes that `MaterialProperties`
+    field's value (same unit); a value in `values` overrides it. The one place a law's material constants are
+    filled, for the library (`run_shot`) and the study config alike. A constant that neither gives is an
+    InputError naming the material key.
+
+    Args:
+        law: the strength law.
+        values: parameter values by declared name, in the units the names carry.
+        material: the flyer and target material, as `MaterialProperties` or a study config's (resolved)
+            `material` section, a mapping of the same keys; None: no material (every material constant must
+            be in `values`).
+    """
+    filled = dict(values)
+    for param in law.params:
+        if param.material is None or param.name in filled:
+            continue
+        value = material.get(param.material) if isinstance(material, Mapping) else getattr(material, param.material, None)
+        if value is None:
+            raise InputError(f"material.{param.material}: missing; {law.name}'s {param.name} is this property of the "
+                             f"material (give material.{param.material}, or {param.name} to the law)")
+        filled[param.name] = value
+    return filled
+
+
+def check_given(law: Law, values: Mapping) -> None:
+    """Check parameter values before the material's constants are filled in (`law_values`): InputError naming
+    an unknown parameter, a non-finite value, or a missing one that neither a default nor the material gives."""
+    _names_known(law, values)
+    bad = [k for k, v in values.items() if not np.all(np.isfinite(v))]
+    if bad:
+        raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
+    missing = [p.name for p in law.params if p.name not in values and p.default is None and p.material is None]
+    if missing:
+        raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
+
+
 def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
-    """The user's values completed with the declared defaults; InputError naming an unknown or
-    missing parameter, a non-finite value or a violated constraint."""
+    """The user's values (the material's constants filled in, `law_values`) completed with the declared
+    defaults; InputError naming an unknown or missing parameter, a non-finite value or a violated constraint."""
     merged = _completed(law, values)
     bad = [k for k, v in merged.items() if not np.isfinite(v)]
     if bad:
@@ -54,9 +99,7 @@ def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
 def _completed(law: Law, values: Mapping):
     """`values` completed with the declared defaults, by parameter name; InputError naming an unknown
     or missing parameter."""
-    unknown = [k for k in values if k not in law.names()]
-    if unknown:
-        raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
+    _names_known(law, values)
     merged = {p.name: values.get(p.name, p.default) for p in law.params}
     missing = [k for k, v in merged.items() if v is None]
     if missing:
@@ -64,17 +107,28 @@ def _completed(law: Law, values: Mapping):
     return merged
 
 
-def code_parameters(law: Law, values: Mapping[str, float]):
-    """The law's named tuple in code units from user values (names and units of `law.params`)."""
-    merged = user_values(law, values)
+def _names_known(law: Law, values: Mapping) -> None:
+    unknown = [k for k in values if k not in law.names()]
+    if unknown:
+        raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
+
+
+def code_parameters(law: Law, values: Mapping[str, float], material: MaterialProperties | None = None):
+    """The law's named tuple in code units from user values (names and units of `law.params`), the material
+    constants not in `values` from `material` (`law_values`); an unknown or missing parameter of the law's own
+    is named before a material key."""
+    check_given(law, values)
+    merged = user_values(law, law_values(law, values, material))
     return law.code_type(**{p.field: float(merged[p.name]) * p.to_code for p in law.params})
 
 
 def flow_stress_curve(law: Law, values: Mapping[str, float], plastic_strains, strain_rate_per_s: float,
-                      temperature_K: float, pressure_GPa: float = 0.0, density_ratio: float = 1.0) -> np.ndarray:
+                      temperature_K: float, pressure_GPa: float = 0.0, density_ratio: float = 1.0,
+                      material: MaterialProperties | None = None) -> np.ndarray:
     """Flow stress (MPa) at each equivalent plastic strain, at a constant equivalent strain rate (1/s),
-    temperature (K), pressure (GPa) and density ratio rho/rho0."""
-    params = code_parameters(law, values)
+    temperature (K), pressure (GPa) and density ratio rho/rho0; the material constants not in `values` from
+    `material` (`law_values`)."""
+    params = code_parameters(law, values, material)
     rate = strain_rate_per_s * PER_S_TO_PER_US
     pressure = pressure_GPa / MBAR_TO_GPA
     return np.array([law.flow_stress(params, float(e), rate, float(temperature_K), pressure, float(density_ratio))
@@ -82,15 +136,16 @@ def flow_stress_curve(law: Law, values: Mapping[str, float], plastic_strains, st
 
 
 def yield_stress_MPa(law: Law, values: Mapping[str, np.ndarray], strain_rate_per_s: float,
-                     temperature_K: float) -> np.ndarray:
+                     temperature_K: float, material: MaterialProperties | None = None) -> np.ndarray:
     """The flow stress (MPa) at zero plastic strain of many parameter sets, at a constant equivalent strain
     rate (1/s) and temperature (K), zero pressure and the reference density.
 
     `values` maps the law's parameter names (user units, as `flow_stress_curve`) to arrays of one length
-    (scalars broadcast); declared defaults fill the material constants left out. The rows are not checked
+    (scalars broadcast); `material` fills the material constants left out (`law_values`), declared defaults
+    the rest. The rows are not checked
     against the law's constraints (`user_values` checks one set): this is the emulator's input map, which
     evaluates the law at every sampler point of a box whose corners meet them."""
-    merged = _completed(law, values)
+    merged = _completed(law, law_values(law, values, material))
     by_field = {p.field: np.asarray(merged[p.name], dtype=float) * p.to_code for p in law.params}
     columns = np.broadcast_arrays(*(by_field[field] for field in law.code_type._fields))
     rate, T = strain_rate_per_s * PER_S_TO_PER_US, float(temperature_K)
@@ -100,18 +155,21 @@ def yield_stress_MPa(law: Law, values: Mapping[str, np.ndarray], strain_rate_per
 
 
 def shear_modulus_gpa(law: Law, values: Mapping[str, float], temperature_K: float, pressure_GPa: float = 0.0,
-                      density_ratio: float = 1.0) -> float | None:
-    """The law's shear modulus (GPa) at the state, or None for laws without a shear-modulus law."""
+                      density_ratio: float = 1.0, material: MaterialProperties | None = None) -> float | None:
+    """The law's shear modulus (GPa) at the state, or None for laws without a shear-modulus law; the material
+    constants not in `values` from `material` (`law_values`)."""
     if law.shear_modulus is None:
         return None
-    params = code_parameters(law, values)
+    params = code_parameters(law, values, material)
     G = law.shear_modulus(params, pressure_GPa / MBAR_TO_GPA, float(temperature_K), float(density_ratio))
     return G * MBAR_TO_GPA
 
 
-def melt_temperature_K(law: Law, values: Mapping[str, float], density_ratio: float = 1.0) -> float | None:
+def melt_temperature_K(law: Law, values: Mapping[str, float], density_ratio: float = 1.0,
+                       material: MaterialProperties | None = None) -> float | None:
     """The law's melting temperature (K) at the density ratio rho/rho0, at and above which its flow stress
-    is zero, or None for a law without a melt cut-off (Zerilli-Armstrong)."""
+    is zero, or None for a law without a melt cut-off (Zerilli-Armstrong); the material constants not in
+    `values` from `material` (`law_values`)."""
     if law.melt_temperature is None:
         return None
-    return float(law.melt_temperature(code_parameters(law, values), float(density_ratio)))
+    return float(law.melt_temperature(code_parameters(law, values, material), float(density_ratio)))

@@ -1,6 +1,9 @@
 """Every strength law's parameters, declared in one place: name (unit-suffixed, as the user writes it),
 the symbol of the paper and the kernel's field, user unit, factor to code units (Mbar, K, 1/us, g/cc,
-g/mol; `shockcal.units`), default (material constants only; calibrated parameters have none) and meaning.
+g/mol; `shockcal.units`), meaning, and either a default (a convention of the law: Steinberg-Guinan's eps_i,
+Zerilli-Armstrong's reference rate) or the `MaterialProperties` field that gives it (`material`: a property
+of the study's material, density, molar mass, melt temperature, filled by `shockcal.hydro.laws.law_values`);
+calibrated parameters have neither.
 
 A user value times `to_code` is the kernel's value. Prior boxes for aluminium, with sources, are in
 config/models.yaml (`shockcal.hydro.laws.boxes`).
@@ -44,7 +47,9 @@ MPA_TO_MBAR = 1.0e-3 / MBAR_TO_GPA
 @dataclass(frozen=True)
 class Param:
     """One parameter of a law: `name` as the user gives it (unit-suffixed unless dimensionless),
-    `field` of the kernel's named tuple, `unit` of the user value, `to_code` its factor to code units."""
+    `field` of the kernel's named tuple, `unit` of the user value, `to_code` its factor to code units;
+    `default` its value when not given, or `material` the `MaterialProperties` field (same unit) that gives
+    it when not given."""
 
     name: str
     field: str
@@ -52,10 +57,11 @@ class Param:
     to_code: float
     meaning: str
     default: float | None = None
+    material: str | None = None
 
 
-def _p(name, field, unit, to_code, meaning, default=None) -> Param:
-    return Param(name, field, unit, to_code, meaning, default)
+def _p(name, field, unit, to_code, meaning, default=None, material=None) -> Param:
+    return Param(name, field, unit, to_code, meaning, default, material)
 
 
 def _mpa(name, field, meaning, default=None) -> Param:
@@ -112,9 +118,10 @@ JOHNSON_COOK = Law(
         _one("C", "strain-rate coefficient"),
         _one("n", "hardening exponent"),
         _one("m", "thermal-softening exponent"),
-        _p("T_ref_K", "T_ref", "K", 1.0, "reference (room) temperature", 298.0),
-        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature (SPEC default 893 K)", 893.0),
-        _p("rate_ref_per_s", "rate_ref", "1/s", PER_S_TO_PER_US, "reference strain rate", 1.0),
+        _p("T_ref_K", "T_ref", "K", 1.0, "reference (room) temperature", material="T_ref_K"),
+        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature", material="T_melt_K"),
+        _p("rate_ref_per_s", "rate_ref", "1/s", PER_S_TO_PER_US, "reference strain rate",
+           material="strain_rate_ref_per_s"),
     ),
     JohnsonCook, johnson_cook_flow_stress,
     constraints=(("T_melt_K > T_ref_K", lambda v: v["T_melt_K"] > v["T_ref_K"]),
@@ -134,9 +141,9 @@ STEINBERG_GUINAN = Law(
         _gpa("G0_GPa", "G0", "shear modulus at P = 0, T = 300 K"),
         _p("dGdP", "dGdP", "-", 1.0, "G'_P = dG/dP"),
         _p("dGdT_over_G0_per_K", "dGdT_over_G0", "1/K", 1.0, "G'_T / G0 = (dG/dT) / G0 (negative)"),
-        _p("T_m0_K", "T_m0", "K", 1.0, "melt temperature at eta = 1 (Steinberg 1996, Al alloys)", 1220.0),
-        _one("gamma0", "Grueneisen coefficient of the melt law (Steinberg 1996, Al 6061-T6)", 1.97),
-        _one("a", "first-order volume coefficient of the melt law (Steinberg 1996)", 1.5),
+        _p("T_m0_K", "T_m0", "K", 1.0, "melt temperature at eta = 1", material="melt_T_m0_K"),
+        _p("gamma0", "gamma0", "-", 1.0, "Grueneisen coefficient of the melt law", material="melt_gamma0"),
+        _p("a", "a", "-", 1.0, "first-order volume coefficient of the melt law", material="melt_a"),
     ),
     SteinbergGuinan, steinberg_guinan_flow_stress, steinberg_guinan_shear_modulus,
     constraints=(("G0_GPa > 0", lambda v: v["G0_GPa"] > 0),
@@ -162,11 +169,11 @@ PRESTON_TONKS_WALLACE = Law(
         _one("y1", "overdriven yield coefficient"),
         _one("y2", "overdriven yield exponent"),
         _one("beta", "overdriven saturation exponent"),
-        _p("M_g_per_mol", "M", "g/mol", 1.0, "molar mass (Al)", 26.9815),
-        _p("rho0_g_per_cc", "rho0", "g/cc", 1.0, "reference density (SPEC Al-5083)", 2.668),
+        _p("M_g_per_mol", "M", "g/mol", 1.0, "molar mass", material="molar_mass_g_per_mol"),
+        _p("rho0_g_per_cc", "rho0", "g/cc", 1.0, "reference density", material="rho0_g_cc"),
         _gpa("G0_GPa", "G0", "shear modulus at 0 K"),
         _one("alpha", "linear thermal softening of G"),
-        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature (SPEC default 893 K)", 893.0),
+        _p("T_melt_K", "T_melt", "K", 1.0, "melt temperature", material="T_melt_K"),
     ),
     PrestonTonksWallace, ptw_flow_stress, ptw_shear_modulus,
     constraints=(  # PTW 2003 sec. II (also lanl/impala's PTW_goodparam): yield below saturation, both falling with T
