@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from shockcal.emulator.pcgp import Z90
+from shockcal.emulator.held_out import Z90
 from shockcal.emulator.study_emulator import fit_emulator
 from shockcal.io import read_table
 from shockcal.reference import reference_dir

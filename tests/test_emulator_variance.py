@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from shockcal.emulator.pcgp import Z90, PCGPEmulator, Settings
+from shockcal.emulator.held_out import Z90
+from shockcal.emulator.pcgp import PCGPEmulator, Settings
 from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
 

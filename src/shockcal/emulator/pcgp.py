@@ -6,7 +6,8 @@ basis weight gets its own GP (`shockcal.emulator.gp`) over inputs scaled to [0, 
 and covariance of the outputs, adding the covariance of what the truncated basis leaves out, with each
 output's sd scaled by a factor calibrated by K-fold (constant per output, or varying smoothly over the
 box: `shockcal.emulator.variance_model`), and an error model (`shockcal.emulator.error_model`) around them.
-Cross-validation: closed-form LOO (diagnostic), K-fold and the outer check (everything refitted).
+Cross-validation: closed-form LOO (diagnostic), K-fold and the outer check (everything refitted); the
+held-out predictions and the sd calibration read from them are `shockcal.emulator.held_out`.
 Saved as one .npz (arrays and a JSON header); no live object is pickled.
 
 This module knows nothing of shots or designs: the study's emulator (`shockcal.emulator.study_emulator`) maps design
@@ -29,15 +30,14 @@ from threadpoolctl import ThreadpoolController, threadpool_limits
 
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.gp import GaussianProcess, Hyper
+from shockcal.emulator.held_out import HeldOut, blend_factors, cross_fitted, sd_calibration
 from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
 from shockcal.io import atomic_path
 
 FORMAT_VERSION = 5                  # 5: the smooth sd model (4 had constant sd factors only, 3 no error tails)
 SD_MODELS = ("constant", "smooth")
-Z90 = 1.6449                        # half-width of a central 90% normal band, in sd (z_0.95 = 1.64485 to 4 digits)
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
-SWITCH_MIN_RUNS = 30                # held-out values past a switch needed for its own sd factor
 PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
 log = logging.getLogger("shockcal.emulator.pcgp")
 
@@ -74,31 +74,6 @@ class Switch:
     numerator: int
     denominator: int
     affected: list[int]
-
-
-@dataclass
-class HeldOut:
-    """Held-out predictions of a cross-validation scheme: row indices, mean and sd (N, F), and the
-    covariance (N, F, F) where the scheme has it (not closed-form LOO)."""
-
-    scheme: str
-    rows: np.ndarray
-    mean: np.ndarray
-    sd: np.ndarray
-    cov: np.ndarray | None = None
-
-    def scaled(self, factors: np.ndarray) -> HeldOut:
-        """The same predictions with sd (and covariance) scaled by per-row, per-feature factors (N, F)."""
-        cov = None if self.cov is None else self.cov * factors[:, :, None] * factors[:, None, :]
-        return HeldOut(self.scheme, self.rows, self.mean, self.sd * factors, cov)
-
-    def distances(self, y: np.ndarray) -> tuple[np.ndarray, int]:
-        """Squared Mahalanobis distance of each held-out error (y[rows] - mean) under its covariance,
-        in the space the covariance spans (a pseudo-inverse: duplicated outputs make it singular),
-        and that space's dimension (the covariances' median rank)."""
-        err = y[self.rows] - self.mean
-        rank = int(np.median(np.linalg.matrix_rank(self.cov, hermitian=True)))
-        return np.einsum("ni,nij,nj->n", err, np.linalg.pinv(self.cov, hermitian=True), err), rank
 
 
 def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
@@ -187,7 +162,7 @@ class PCGPEmulator:
         With `settings.calibrate_sd`, a K-fold follows and each feature's sd is scaled by the 90%
         quantile of its K-fold |error| / sd over 1.645: one factor per feature, never per run, and
         a second one for the feature's held-out values past a regime `switch` (e.g. single-wave
-        traces), when there are at least SWITCH_MIN_RUNS of them. With `settings.sd_model ==
+        traces), when there are at least `held_out.SWITCH_MIN_RUNS` of them. With `settings.sd_model ==
         "smooth"`, the K-fold's log z^2 is first fitted by a smooth variance model g over the box
         (`shockcal.emulator.variance_model`), the sd is multiplied by exp(g(x) / 2), and the constant factors
         are then fitted to the z values so rescaled: g gives the shape over the box, the factors the
@@ -205,8 +180,8 @@ class PCGPEmulator:
         if settings.calibrate_sd or settings.error_tails == "student_t":
             held, folds = model._kfold(settings.cv_folds, settings.seed)
             if settings.calibrate_sd:
-                model.sd_factor, model.variance = _calibration(model, held, np.ones(len(held.rows), dtype=bool))
-                held = _cross_fitted(model, held, folds)
+                model.sd_factor, model.variance = sd_calibration(model, held, np.ones(len(held.rows), dtype=bool))
+                held = cross_fitted(model, held, folds)
             model.kfold = held
             if settings.error_tails == "student_t":
                 model.error = ErrorModel.fit(*held.distances(model.y_train))
@@ -286,7 +261,7 @@ class PCGPEmulator:
         """(N, F) sd factors: the constant factors at the predicted means (N, F), blending the usual
         and the switched regime's, times the smooth model's exp(g / 2) at scaled inputs x (N, d) and
         the uncalibrated sd raw_sd (N, F, output units) when there is one."""
-        factors = _blend(self.sd_factor, self.switch_weight(mean))
+        factors = blend_factors(self.sd_factor, self.switch_weight(mean))
         return factors if self.variance is None else factors * self.variance.sd_factors(x, raw_sd)
 
     def _predict_weights(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -326,7 +301,7 @@ class PCGPEmulator:
         if self.kfold is not None and (k, seed) == (self.settings.cv_folds, self.settings.seed):
             return self.kfold
         held, folds = self._kfold(k, seed)
-        return _cross_fitted(self, held, folds) if self.settings.calibrate_sd else held
+        return cross_fitted(self, held, folds) if self.settings.calibrate_sd else held
 
     def _kfold(self, k: int, seed: int) -> tuple[HeldOut, list[np.ndarray]]:
         """K-fold held-out predictions with the fold models' own sd, and the folds."""
@@ -404,51 +379,6 @@ class PCGPEmulator:
                              f"shockcal reads PC-GP emulators of version {FORMAT_VERSION} (5: the smooth sd "
                              f"model): refit it")
         return cls.from_saved(header, arrays)
-
-
-def _calibration(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> tuple[np.ndarray, VarianceModel | None]:
-    """The sd calibration from the rows `use` of a held-out set with the fold models' own sd: with
-    sd_model "smooth", the variance model g fitted to their z values, then the (2, F) constant
-    factors (`_sd_factor`) of the z values divided by exp(g / 2); with "constant", the factors alone."""
-    if model.settings.sd_model != "smooth":
-        return _sd_factor(model, held, use), None
-    x, sd = model.x_train[held.rows[use]], held.sd[use]
-    variance = VarianceModel.fit(x, (held.mean[use] - model.y_train[held.rows[use]]) / sd, sd, model.sd_groups)
-    smooth = np.ones_like(held.sd)
-    smooth[use] = variance.sd_factors(x, sd)
-    return _sd_factor(model, held.scaled(smooth), use), variance
-
-
-def _sd_factor(model: PCGPEmulator, held: HeldOut, use: np.ndarray) -> np.ndarray:
-    """(2, F) sd factors from the rows `use` of a held-out set: per feature, the 90% quantile of
-    |error| / sd over 1.645, in the usual regime (row 0) and past a switch (row 1; the usual one
-    where fewer than SWITCH_MIN_RUNS held-out values are past it)."""
-    z = np.abs(held.mean[use] - model.y_train[held.rows[use]]) / held.sd[use]
-    switched = model.switch_weight(held.mean[use]) > 0.5
-    factors = np.tile(np.quantile(z, 0.9, axis=0) / Z90, (2, 1))
-    for col in np.flatnonzero(switched.sum(0) >= SWITCH_MIN_RUNS):
-        past = switched[:, col]
-        factors[:, col] = np.quantile(z[~past, col], 0.9) / Z90, np.quantile(z[past, col], 0.9) / Z90
-    return factors
-
-
-def _blend(factors: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    """(N, F) factors: the usual regime's, moved towards the switched one's by weight (N, F)."""
-    return factors[0] + weight * (factors[1] - factors[0])
-
-
-def _cross_fitted(model: PCGPEmulator, held: HeldOut, folds) -> HeldOut:
-    """K-fold sd scaled, fold by fold, by the calibration of the other folds (an honest coverage:
-    nested, the variance model and the factors never see the fold they scale)."""
-    fold_of = np.concatenate([np.full(len(f), j) for j, f in enumerate(folds)])
-    factors = np.empty_like(held.sd)
-    for j in range(len(folds)):
-        here = fold_of == j
-        constant, variance = _calibration(model, held, ~here)
-        factors[here] = _blend(constant, model.switch_weight(held.mean[here]))
-        if variance is not None:
-            factors[here] *= variance.sd_factors(model.x_train[held.rows[here]], held.sd[here])
-    return held.scaled(factors)
 
 
 def _component_count(singular_values: np.ndarray, n_components: float) -> int:

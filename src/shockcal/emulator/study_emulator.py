@@ -28,7 +28,8 @@ import pandas as pd
 
 from shockcal.design.tables import ShotMapping
 from shockcal.emulator.error_model import ErrorModel
-from shockcal.emulator.pcgp import FORMAT_VERSION, Z90, PCGPEmulator, Settings, Switch
+from shockcal.emulator.held_out import Z90
+from shockcal.emulator.pcgp import FORMAT_VERSION, PCGPEmulator, Settings, Switch
 from shockcal.emulator.yield_input import YieldInput
 from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path

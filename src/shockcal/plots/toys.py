@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from shockcal.emulator.gp import GaussianProcess, Hyper, correlation
-from shockcal.emulator.pcgp import Z90
+from shockcal.emulator.held_out import Z90
 from shockcal.plots.style import COLORS, no_data, styled, subplots
 
 THETA_RUNS = np.array([0.05, 0.35, 0.65, 0.95])
