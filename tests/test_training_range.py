@@ -79,7 +79,7 @@ def test_calibrate_checks_before_it_samples_and_the_config_key_lets_it_pass(pape
            "v_jumpoff": 2.0, **INSIDE, "v_slope1": 150.0}
     observed = pd.DataFrame([row])
     paper_config["checks"]["plateau_vs_velocity"] = False
-    paper_config["calibration"].update(n_live=100, n_eff=100, draws=100)
+    paper_config["calibration"].update(n_live=50, n_eff=100, draws=100)
     with pytest.raises(InputError, match="obs.csv: shot 104S: measured v_slope1 = 150.0 m/s is outside"):
         calibrate(TrainedStandIn(), ["104S"], observed, calibration_settings(paper_config, ["104S"]), source="obs.csv")
     assert calibration_settings(paper_config, ["104S"], check=True).check_training_range is False
