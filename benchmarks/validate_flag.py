@@ -94,8 +94,8 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
                           config: dict) -> pd.DataFrame:
     """Per calibration feature: R^2 of a 10-fold GP prediction of ours - FLAG from the shot's inputs
     (with the emulator's input powers), and the scatter sd (m/s) it leaves."""
+    from shockcal.emulator.input_map import shot_input_map
     from shockcal.emulator.pcgp import PCGPEmulator, Settings
-    from shockcal.emulator.study_emulator import shot_input_map
     from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     ok = ours[ours["status"] == "ok"].set_index("run")

@@ -394,8 +394,9 @@ def _one_line(err, *fragments):
 def _small_emulator(config, directory=None):
     """A real 104S-only study emulator (20 runs of smooth made-up features on the paper's box), saved
     to `directory` when given."""
+    from shockcal.emulator.input_map import shot_input_map
     from shockcal.emulator.pcgp import PCGPEmulator, Settings
-    from shockcal.emulator.study_emulator import Block, Emulator, shot_input_map
+    from shockcal.emulator.study_emulator import Block, Emulator
 
     bounds = prior_bounds(config)
     mapping = shot_mapping(config, "104S")

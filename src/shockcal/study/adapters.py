@@ -149,7 +149,8 @@ def emulator_spec(config: dict, shots) -> EmulatorSpec:
     """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
     inputs eps^n and T*^m for Johnson-Cook only; the yield input for the laws of `emulator.yield_input`,
     at material.T_ref_K with the law's material constants)."""
-    from shockcal.emulator.study_emulator import POWER_INPUTS, EmulatorSpec
+    from shockcal.emulator.input_map import POWER_INPUTS
+    from shockcal.emulator.study_emulator import EmulatorSpec
     from shockcal.emulator.yield_input import YieldInput
 
     section = config["emulator"]
