@@ -7,7 +7,7 @@ n = 0 meaning eps_p^0 = 1, no softening at T* <= 0 and none left at T* >= 1. The
 `hardening`, `rate_factor` and `thermal_factor` in the order `hydro.strength.flow_stress` uses, so
 it equals the hydrocode's Johnson-Cook flow stress bit for bit (tests/test_strength_laws.py).
 
-The solver's floor (`shockcal.hydro.plastic_return.law_return`): the cell caches A + B eps_p^n in `hard`
+The solver's floor (`shockcal.hydro.plastic_return.plastic_return`): the cell caches A + B eps_p^n in `hard`
 (`johnson_cook_hardening`) and remembers, at its last full evaluation that found it elastic, the thermal
 factor 1 - T*^m at that temperature (`flow_floor`), a lower bound of it FLOOR_MARGIN_K hotter
 (`floor_hotter`, `thermal_factor_below`: no extra pow) and the temperature (`floor_T`). The floor is `hard`
