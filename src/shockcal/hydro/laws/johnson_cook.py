@@ -11,9 +11,9 @@ The solver's floor (`shockcal.hydro.plastic_return.plastic_return`): the cell ca
 (`johnson_cook_hardening`) and remembers, at its last full evaluation that found it elastic, the thermal
 factor 1 - T*^m at that temperature (`flow_floor`), a lower bound of it FLOOR_MARGIN_K hotter
 (`floor_hotter`, `thermal_factor_below`: no extra pow) and the temperature (`floor_T`). The floor is `hard`
-times the remembered factor that holds at the cell's temperature: a lower bound of the flow stress (the rate
-factor is at least 1, the thermal factor falls with T, `hard` holds the current plastic strain), so an
-elastic cell costs no pow or log.
+times the remembered factor that holds at the cell's temperature times the rate factor: a lower bound of the
+flow stress (the thermal factor falls with T, `hard` holds the current plastic strain), so an elastic cell
+costs at most one log and no pow.
 """
 
 from __future__ import annotations
@@ -65,14 +65,14 @@ def johnson_cook_hardening(law, eps_p):
 def johnson_cook_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
     """A lower bound (Mbar) of the flow stress: `hard` (A + B eps_p^n, Mbar) times the thermal factor the
     cell remembered at floor_T (K) while T (K) is no hotter, the one FLOOR_MARGIN_K hotter up to that, else
-    -1 (none); none for C < 0, where the rate factor may fall below 1. G, strain_rate and eta are not used."""
-    if law.C < 0.0:
-        return -1.0
+    -1 (none), times the rate factor at the equivalent strain rate (1/us). G and eta are not used."""
     if T <= floor_T:
-        return hard * flow_floor
-    if T <= floor_T + FLOOR_MARGIN_K:
-        return hard * floor_hotter
-    return -1.0
+        thermal = flow_floor
+    elif T <= floor_T + FLOOR_MARGIN_K:
+        thermal = floor_hotter
+    else:
+        return -1.0
+    return hard * thermal * rate_factor(law.C, strain_rate, law.rate_ref)
 
 
 @njit(cache=True, error_model="numpy")
