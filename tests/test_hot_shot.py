@@ -12,9 +12,10 @@ import pytest
 from shockcal.errors import ConfigError
 from shockcal.hydro import Geometry, HydroSettings, ShotParameters, run_shot
 from shockcal.hydro.eos import cold_pressure
+from shockcal.hydro.laws.johnson_cook import JohnsonCook
 from shockcal.hydro.material_library import load_material
 from shockcal.hydro.solver import initial_mesh
-from shockcal.hydro.state import Strength
+from shockcal.hydro.state import LawStrength
 from shockcal.hydro.strength import thermal_factor
 from shockcal.study.adapters import hydro_inputs
 from shockcal.study.stages import stage_config
@@ -53,7 +54,7 @@ def test_hot_initial_state_is_at_zero_pressure_and_T0(T0):
     material = AL5083.code_units()
     initial = AL5083.initial_state(T0)
     dx = 4.0e-4
-    strength = Strength(G_MBAR, A_MBAR, 0.0, 0.0, 0.0, M, 1e-6)
+    strength = LawStrength(JohnsonCook(A_MBAR, 0.0, 0.0, 0.0, M, material.T_ref, material.T_melt, 1e-6), G_MBAR)
     nodes, cells = initial_mesh(3, 4, dx, 0.0204, initial, strength, material)
     solid = np.arange(8) != 3
     volume = cells.length[solid] / cells.mass[solid]

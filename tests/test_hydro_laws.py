@@ -69,9 +69,9 @@ def _run_kernel_strength(monkeypatch, params, strength):
                                       (0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),     # hot, 106S
                                       (0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30)])    # m = 0.01
 def test_johnson_cook_general_return_equals_the_floored_one(monkeypatch, table_iv):
-    """Johnson-Cook through the general return (its law tuple, the flow stress evaluated every step) gives
-    the floored kernel's trace: the floors only skip provably elastic steps. Two kernels, so compared at the
-    rounding floor (rtol 1e-10 of the peak; bit for bit on the machines measured)."""
+    """`ShotParameters` (Table IV inputs) give the trace of Johnson-Cook's registry tuple built from the
+    material's constants: one return for both since 2026-11-28 (before, two kernels: the floored one and the
+    general one); whether the floors change a trace is tests/test_hydro.py's stored traces from before them."""
     A, B, C, n, m, velocity, G = table_iv
     floored = run_shot(ShotParameters.from_table_iv(*table_iv), THIN, AL5083)
     law = get_law("johnson-cook").code_type(A, B, C, n, m, AL5083.T_ref_K, AL5083.T_melt_K, AL5083.rate_ref_per_us())

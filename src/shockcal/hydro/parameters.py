@@ -16,9 +16,7 @@ Any strength law of `shockcal.hydro.laws` (docs/strength_laws.md), by its declar
 
 Laws with a shear-modulus law (Steinberg-Guinan, PTW) take G from it, cell by cell; the others
 (Johnson-Cook, Zerilli-Armstrong) need `shear_modulus_GPa`. Johnson-Cook given this way runs the
-solver's general return (every step, no floors), which gives the same traces as `ShotParameters`'
-floored one (at the rounding floor; bit for bit on the machines measured), only slower
-(tests/test_hydro_laws.py).
+same registry entry and return as `ShotParameters` (tests/test_hydro_laws.py).
 """
 
 from __future__ import annotations

@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from shockcal.hydro.laws.johnson_cook import JohnsonCook
 from shockcal.hydro.parameters import LawShotParameters, ShotParameters
 from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.solver import simulate
-from shockcal.hydro.state import FAILURE_REASONS, STATUS_OK, LawStrength, Strength
+from shockcal.hydro.state import FAILURE_REASONS, STATUS_OK, LawStrength
 from shockcal.units import CM_US_TO_M_S, UM_TO_CM
 
 
@@ -101,15 +102,16 @@ def run_shot(params: ShotParameters | LawShotParameters, geometry: Geometry, mat
 
 
 def kernel_strength(params: ShotParameters | LawShotParameters, material: MaterialProperties):
-    """(impact velocity in cm/us, the kernel's strength tuple): `Strength` (Johnson-Cook with the
-    material's T_ref, T_melt and reference rate, floored return) or `LawStrength` (any law, its material
-    constants from `material` unless given)."""
+    """(impact velocity in cm/us, the kernel's strength tuple `LawStrength`): Johnson-Cook's tuple with the
+    material's T_ref, T_melt and reference rate for `ShotParameters`, or any law's, its material constants
+    from `material` unless given, for `LawShotParameters`."""
     if isinstance(params, LawShotParameters):
         return params.velocity_m_s / CM_US_TO_M_S, LawStrength(params.law_parameters(material),
                                                                params.shear_modulus_Mbar())
     inputs = params.table_iv()
-    return inputs.velocity_cm_us, Strength(inputs.shear_modulus_Mbar, inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n,
-                                           inputs.m, material.rate_ref_per_us())
+    return inputs.velocity_cm_us, LawStrength(
+        JohnsonCook(inputs.A_Mbar, inputs.B_Mbar, inputs.C, inputs.n, inputs.m, material.T_ref_K, material.T_melt_K,
+                    material.rate_ref_per_us()), inputs.shear_modulus_Mbar)
 
 
 def load_kernel(kernel, args) -> None:

@@ -24,12 +24,12 @@ rear node nf and the target's front node nf+1. Both outer nodes are free surface
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
    only), the cell's shear modulus, elastic trial deviator and radial return onto the strength law
-   (`shockcal.hydro.plastic_return`: Johnson-Cook's skipped while the trial lies inside the cell's flow-stress floor,
-   `floor_at`, `new_floors`; any other law's evaluated every step), energy equation, EOS;
+   (`shockcal.hydro.plastic_return`: the law's skipped while the trial lies inside the cell's flow-stress floor,
+   `laws.kernels.law_flow_stress_floor`), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
-(`shockcal.hydro.state`: `Material`, `Strength` for Johnson-Cook or `LawStrength` for any law, `Numerics`; `shockcal.units`
+(`shockcal.hydro.state`: `Material`, `LawStrength` for any law, `Numerics`; `shockcal.units`
 converts); numba compiles the kernels once per strength tuple type. Kernels that loop over the mesh
 take its arrays out of `Nodes` / `Cells` once: a field read per cell would cost a reference count.
 Only the region the waves have reached is updated: an undisturbed cell has exactly zero stress,
@@ -242,7 +242,7 @@ def simulate(nf, nt, dx, velocity, initial, strength, material, numerics, t_out,
         dx: cell size (cm).
         velocity: impact velocity of the flyer (cm/us).
         initial: `InitialState` of both plates (g/cc, (cm/us)^2).
-        strength: `Strength` (Johnson-Cook: Mbar, -, 1/us) or `LawStrength` (a law's tuple and G in Mbar).
+        strength: `LawStrength` (a law's tuple and G in Mbar).
         material: `Material` (code units).
         numerics: `Numerics` (artificial viscosity, CFL, time steps in us).
         t_out: output times (us), t_out[0] = 0.

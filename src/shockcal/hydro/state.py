@@ -1,6 +1,6 @@
 """The hydrocode's state and parameters as named tuples in code units (cm, us, g/cc, Mbar), the kernels' currency.
 
-`Material`, `InitialState`, `Strength` (Johnson-Cook) or `LawStrength` (any law) and `Numerics` are what a run
+`Material`, `InitialState`, `LawStrength` (any law, Johnson-Cook included) and `Numerics` are what a run
 hands the kernels (`shockcal.hydro.settings` builds them from user units); `Nodes` and `Cells` are the mesh's
 state (drawn in `shockcal.hydro.solver`); `KernelResult` is what `solver.simulate` returns, with a status code
 and its reason (`FAILURE_REASONS`).
@@ -37,18 +37,6 @@ class InitialState(NamedTuple):
 
     rho: float             # g/cc
     E: float               # specific internal energy, (cm/us)^2
-
-
-class Strength(NamedTuple):
-    """Shear modulus and Johnson-Cook parameters of one run (Mbar, -, 1/us)."""
-
-    G: float
-    A: float
-    B: float
-    C: float
-    n: float
-    m: float
-    rate_ref: float
 
 
 class LawStrength(NamedTuple):
@@ -95,15 +83,11 @@ class Nodes(NamedTuple):
 class Cells(NamedTuple):
     """Cell state, cells 0..N (cell `gap` is the contact gap: no mass, its length is the gap).
 
-    `flow_floor` is a lower bound of the cell's rate-free flow stress (A + B eps_p^n)(1 - T*^m),
-    valid while its temperature stays at or below `floor_T`, the temperature of its last full
-    evaluation (the thermal factor falls with T, the hardening grows with eps_p); `floor_hotter`
-    is one valid up to `plastic_return.FLOOR_MARGIN_K` above it (`strength.thermal_factor_below`, no extra pow),
-    so that a slowly heating cell keeps a floor. A trial stress inside a floor is elastic without
-    a pow or log; inside the floor times the rate factor (one log), elastic without a pow. The floors
-    are Johnson-Cook's (`Strength`); under `LawStrength` `hard` holds the law's hardening and the three
-    floor slots the floor a law remembers, in the law's meaning (`plastic_return.law_return`; PTW: tau^,
-    the sixth power of the lowest rate ratio and the highest temperature it holds for)."""
+    `hard` holds the law's cached hardening and the three floor slots (`flow_floor`, `floor_hotter`,
+    `floor_T`) the floor the law remembers, in the law's meaning (`plastic_return.plastic_return`;
+    Johnson-Cook: the thermal factor 1 - T*^m at floor_T, K, and a lower bound of it
+    `laws.johnson_cook.FLOOR_MARGIN_K` hotter; PTW: tau^, the sixth power of the lowest rate ratio and the
+    highest temperature it holds for). A trial stress inside the floor is elastic without evaluating the law."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
@@ -112,7 +96,7 @@ class Cells(NamedTuple):
     s: np.ndarray          # deviator s_xx, Mbar
     sigma: np.ndarray      # total stress -(P + q) + s, Mbar
     eps_p: np.ndarray      # equivalent plastic strain
-    hard: np.ndarray       # A + B eps_p^n (Mbar), or the law's cached hardening (laws.kernels.law_hardening)
+    hard: np.ndarray       # the law's cached hardening (laws.kernels.law_hardening; Johnson-Cook: A + B eps_p^n, Mbar)
     flow_floor: np.ndarray  # Mbar
     floor_hotter: np.ndarray  # Mbar
     floor_T: np.ndarray    # K

@@ -14,7 +14,13 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from shockcal.hydro.laws.johnson_cook import JohnsonCook, johnson_cook_flow_stress
+from shockcal.hydro.laws.johnson_cook import (
+    JohnsonCook,
+    johnson_cook_flow_stress,
+    johnson_cook_flow_stress_floor,
+    johnson_cook_hardening,
+    johnson_cook_remember_floor,
+)
 from shockcal.hydro.laws.preston_tonks_wallace import (
     PrestonTonksWallace,
     ptw_flow_stress,
@@ -127,6 +133,8 @@ JOHNSON_COOK = Law(
     constraints=(("T_melt_K > T_ref_K", lambda v: v["T_melt_K"] > v["T_ref_K"]),
                  ("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0)),
     melt_temperature=lambda law, eta: law.T_melt,
+    hardening=johnson_cook_hardening, flow_stress_floor=johnson_cook_flow_stress_floor,
+    remember_floor=johnson_cook_remember_floor,
 )
 
 STEINBERG_GUINAN = Law(

@@ -6,6 +6,14 @@ with the project's conventions (docs/hydro.md, `hydro/strength.py`): the rate ra
 n = 0 meaning eps_p^0 = 1, no softening at T* <= 0 and none left at T* >= 1. The kernel calls
 `hardening`, `rate_factor` and `thermal_factor` in the order `hydro.strength.flow_stress` uses, so
 it equals the hydrocode's Johnson-Cook flow stress bit for bit (tests/test_strength_laws.py).
+
+The solver's floor (`shockcal.hydro.plastic_return.plastic_return`): the cell caches A + B eps_p^n in `hard`
+(`johnson_cook_hardening`) and remembers, at its last full evaluation that found it elastic, the thermal
+factor 1 - T*^m at that temperature (`flow_floor`), a lower bound of it FLOOR_MARGIN_K hotter
+(`floor_hotter`, `thermal_factor_below`: no extra pow) and the temperature (`floor_T`). The floor is `hard`
+times the remembered factor that holds at the cell's temperature times the rate factor: a lower bound of the
+flow stress (the thermal factor falls with T, `hard` holds the current plastic strain), so an elastic cell
+costs at most one log and no pow.
 """
 
 from __future__ import annotations
@@ -14,7 +22,10 @@ from typing import NamedTuple
 
 from numba import njit
 
-from shockcal.hydro.strength import hardening, rate_factor, thermal_factor
+from shockcal.hydro.strength import hardening, rate_factor, thermal_factor, thermal_factor_below
+
+FLOOR_MARGIN_K = 1.0       # a cell's hotter floor holds up to this much above the temperature it was set at
+FLOOR_SLACK = 1.0 - 1e-12  # keeps the remembered thermal factor below the exact one through rounding
 
 
 class JohnsonCook(NamedTuple):
@@ -34,6 +45,41 @@ class JohnsonCook(NamedTuple):
 def johnson_cook_flow_stress(law, eps_p, strain_rate, T, P, eta):
     """Flow stress (Mbar) at equivalent plastic strain `eps_p`, equivalent strain rate `strain_rate`
     (1/us), temperature `T` (K); pressure `P` (Mbar) and density ratio `eta` are not used."""
-    homologous = (T - law.T_ref) * (1.0 / (law.T_melt - law.T_ref))
     return (hardening(law.A, law.B, law.n, eps_p) * rate_factor(law.C, strain_rate, law.rate_ref)
-            * thermal_factor(law.m, homologous))
+            * thermal_factor(law.m, _homologous(law, T)))
+
+
+@njit(cache=True, error_model="numpy")
+def _homologous(law, T):
+    """T* = (T - T_ref) / (T_melt - T_ref), in the hydrocode's order of operations."""
+    return (T - law.T_ref) * (1.0 / (law.T_melt - law.T_ref))
+
+
+@njit(cache=True, error_model="numpy")
+def johnson_cook_hardening(law, eps_p):
+    """A + B eps_p^n (Mbar), the hardening the solver caches per cell."""
+    return hardening(law.A, law.B, law.n, eps_p)
+
+
+@njit(cache=True, error_model="numpy")
+def johnson_cook_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+    """A lower bound (Mbar) of the flow stress: `hard` (A + B eps_p^n, Mbar) times the thermal factor the
+    cell remembered at floor_T (K) while T (K) is no hotter, the one FLOOR_MARGIN_K hotter up to that, else
+    -1 (none), times the rate factor at the equivalent strain rate (1/us). G and eta are not used."""
+    if T <= floor_T:
+        thermal = flow_floor
+    elif T <= floor_T + FLOOR_MARGIN_K:
+        thermal = floor_hotter
+    else:
+        return -1.0
+    return hard * thermal * rate_factor(law.C, strain_rate, law.rate_ref)
+
+
+@njit(cache=True, error_model="numpy")
+def johnson_cook_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+    """The cell's remembered thermal factors after a full evaluation found it elastic at T (K): 1 - T*^m
+    and its lower bound FLOOR_MARGIN_K hotter, each just below by FLOOR_SLACK, and T."""
+    homologous = _homologous(law, T)
+    thermal = thermal_factor(law.m, homologous)
+    margin = FLOOR_MARGIN_K * (1.0 / (law.T_melt - law.T_ref))
+    return (FLOOR_SLACK * thermal, FLOOR_SLACK * thermal_factor_below(law.m, homologous, thermal, margin), T)

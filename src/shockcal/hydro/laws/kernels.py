@@ -15,7 +15,7 @@ compiles (no run-time branch, no function objects passed around, so callers stay
            that remember none
 
 The solver skips the full flow stress of a cell whose elastic trial lies inside the floor
-(`shockcal.hydro.plastic_return.law_return`); `hard` is recomputed only when the plastic strain changes,
+(`shockcal.hydro.plastic_return.plastic_return`); `hard` is recomputed only when the plastic strain changes,
 the remembered floor only when a full evaluation finds the cell elastic.
 
 Arguments and units as in `shockcal.hydro.laws` (strain rate the equivalent one, 1/us; T in K; P in
