@@ -264,7 +264,7 @@ def record_paths(study: dict) -> list[str]:
 
 
 def run_set_sizes(config: dict, training_runs: int) -> dict[str, int]:
-    """Runs per shot of every run set (docs/workflow.md; design.smk lists them), in the rules' order."""
+    """Runs per shot of every run set (docs/workflow.md; simulate.smk lists them), in the rules' order."""
     sizes = {
         "training": training_runs,
         "predict": config["predict"]["n_posterior_runs"],
