@@ -72,7 +72,7 @@ class WorkflowPlan:
     effective_text: str  # the merged config every job reads ($SHOCKCAL_CONFIG)
     base_text: str | None  # the base study's config, with new shots only
     design: pd.DataFrame  # the training design, planned when the workflow is read
-    design_source: object
+    design_source: str  # where the design came from (a hypercube, the design file), kept in its metadata
     archive: bool  # simulator.kind archive: no code to run predictive runs
     chunk_size: int
     chunk_digests: dict[str, list[str]]  # shot -> a digest per training chunk
