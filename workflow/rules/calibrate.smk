@@ -44,7 +44,7 @@ TRUTH_RUN_SETS = {"hydrocode": "check", "posterior": "check_posterior"}
 rule check_design:
     """The hydrocode-truth check's truths: a Latin hypercube over the box (run set "check")."""
     output:
-        run_set_path("check", "design.parquet"),
+        PLAN.run_set_path("check", "design.parquet"),
     log:
         f"{LOGS}/check/design.log",
     benchmark:
@@ -63,7 +63,7 @@ rule check_posterior_design:
     input:
         posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
-        run_set_path("check_posterior", "design.parquet"),
+        PLAN.run_set_path("check_posterior", "design.parquet"),
     log:
         f"{LOGS}/check/posterior_design.log",
     benchmark:
@@ -88,7 +88,7 @@ rule calibration_check_batch:
                 {}
                 if w.truth == "emulator"
                 else {
-                    "design": run_set_path(TRUTH_RUN_SETS[w.truth], "design.parquet"),
+                    "design": PLAN.run_set_path(TRUTH_RUN_SETS[w.truth], "design.parquet"),
                     "features": expand(rules.features.output[0], run_set=TRUTH_RUN_SETS[w.truth], shot=SHOTS),
                 }
             )
@@ -116,8 +116,7 @@ rule calibration_check_batch:
         truth=lambda w, input: (
             ""
             if w.truth == "emulator"
-            else f"--truth-design {input.design} --truth-features "
-            + " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.features))
+            else f"--truth-design {input.design} --truth-features {pairs(SHOTS, input.features)}"
         ),
     shell:
         "shockcal calibrate-check --emulator {params.emulator_dir} --shots {params.shots} {params.truth}"

@@ -5,9 +5,8 @@
 
 rule emulator:
     input:
-        design=STUDY_RUNS["design"],  # the training runs; a sequential study's every wave (waves.smk)
-        features=STUDY_RUNS["features"],
-        shot_designs=STUDY_RUNS["shot_designs"],
+        # the training runs (a sequential study's every wave, waves.smk); each new shot's own runs and design
+        **PLAN.study_runs(),
     output:
         emulator=f"{RESULTS}/emulator/emulator.json",
         arrays=f"{RESULTS}/emulator/emulator.npz",
@@ -28,7 +27,7 @@ rule emulator:
         pairs=lambda w, input: " ".join(
             [
                 pairs(SHOTS, input.features),
-                *(["--shot-design", pairs(NEW_SHOTS, input.shot_designs)] if NEW_SHOTS else []),
+                *(["--shot-design", pairs(PLAN.new_shots, input.shot_designs)] if PLAN.new_shots else []),
             ]
         ),
         out=lambda w, output: os.path.dirname(output.emulator),

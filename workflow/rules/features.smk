@@ -12,13 +12,13 @@ rule features_chunk:
     benchmark:
         f"{BENCHMARKS}/{{run_set}}/features/{{shot}}/chunk-{{chunk}}.tsv"
     wildcard_constraints:
-        run_set="|".join(RUN_SET_SIZES),
+        run_set="|".join(PLAN.run_set_sizes),
     priority: 4  # after the hydrocode chunks that are ready, before figures and observed
     conda:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("features"),
-        allow_empty=allow_empty,
+        allow_empty=lambda w: PLAN.allow_empty(w.run_set),
     shell:
         "shockcal features --shot {wildcards.shot} --traces {input} --no-failure-budget {params.allow_empty}"
         " --out {output} > {log} 2>&1"
@@ -27,21 +27,21 @@ rule features_chunk:
 rule features:
     input:
         lambda w: expand(
-            rules.features_chunk.output[0], run_set=w.run_set, shot=w.shot, chunk=RUN_SET_CHUNKS[w.run_set]
+            rules.features_chunk.output[0], run_set=w.run_set, shot=w.shot, chunk=PLAN.run_set_chunks[w.run_set]
         ),
     output:
-        f"{RESULTS}/{{run_set}}/features/{{shot}}.parquet",
+        PLAN.features_path("{run_set}", "{shot}"),
     log:
         f"{LOGS}/{{run_set}}/features/{{shot}}.log",
     benchmark:
         f"{BENCHMARKS}/{{run_set}}/features/{{shot}}.tsv"
     wildcard_constraints:
-        run_set="|".join(RUN_SET_SIZES),
+        run_set="|".join(PLAN.run_set_sizes),
     conda:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("failure_budget"),
-        allow_empty=allow_empty,
+        allow_empty=lambda w: PLAN.allow_empty(w.run_set),
     shell:
         "shockcal features --shot {wildcards.shot} --tables {input} {params.allow_empty} --out {output} > {log} 2>&1"
 
@@ -64,12 +64,12 @@ rule observed:
 
 
 rule observed_base:
-    """The base shots' observed features (the study without its new shots, common.smk), which a sequential
+    """The base shots' observed features (the study without its new shots, PLAN.base_study), which a sequential
     study's steps and the new shots' design read: a shot added later leaves this file alone."""
     input:
-        record_paths(BASE_STUDY),
+        record_paths(PLAN.base_study),
     output:
-        f"{RESULTS}/features/observed_base.parquet",
+        PLAN.observed_base_path,
     log:
         f"{LOGS}/observed_base.log",
     benchmark:
@@ -77,13 +77,13 @@ rule observed_base:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(BASE_STUDY, "observed"),
-        # the base study's config file, a channel as $SHOCKCAL_CONFIG is (common.smk): none without new shots.
+        settings=stage_config(PLAN.base_study, "observed"),
+        # the base study's config file, a channel as $SHOCKCAL_CONFIG is (the Snakefile): none without new shots.
         # A function of `input`, so snakemake does not track it: adding the first shot leaves this job alone.
-        config=lambda w, input: BASE_CONFIG_OPTION,
+        config=lambda w, input: PLAN.base_config_option,
     shell:
         "shockcal observed {params.config} --out {output} > {log} 2>&1"
 
 
-ALL_TARGETS += [rules.features.output[0].format(run_set=training_run_set(shot), shot=shot) for shot in SHOTS]
+ALL_TARGETS += [rules.features.output[0].format(run_set=PLAN.training_run_set(shot), shot=shot) for shot in SHOTS]
 ALL_TARGETS += rules.observed.output

@@ -17,10 +17,10 @@ INPUT_FILES = {
     "cv": lambda _: [rules.emulator.output.cv],
     "emulator_predictions": lambda _: [rules.predict_emulator.output[0]],
     "record": lambda shot: [config["observed"]["records"][shot]["path"]],
-    "sample_simulations": lambda shot: simulations(training_run_set(shot), shot)[:1],
-    "simulations": lambda shot: simulations(training_run_set(shot), shot),
+    "sample_simulations": lambda shot: simulations(PLAN.training_run_set(shot), shot)[:1],
+    "simulations": lambda shot: simulations(PLAN.training_run_set(shot), shot),
     "predicted_simulations": lambda shot: simulations("predict", shot),
-    "features": lambda shot: expand(rules.features.output[0], run_set=training_run_set(shot), shot=shot),
+    "features": lambda shot: expand(rules.features.output[0], run_set=PLAN.training_run_set(shot), shot=shot),
     "predicted_features": lambda shot: expand(rules.features.output[0], run_set="predict", shot=shot),
     "posterior": lambda name: [rules.calibrate.output.samples.format(name=name)],
     "sobol": lambda _: [rules.sensitivity.output[0]],
@@ -64,17 +64,6 @@ for _name, _spec in FIGURE_SPECS.items():
             "shockcal figures --figure {params.figure} --out-dir {params.out_dir}" " {params.inputs} > {log} 2>&1"
 
 
-# the input kinds an archive study cannot make (hydrocode traces, posterior predictive runs)
-RUN_INPUT_KINDS = {"sample_simulations", "simulations", "predicted_simulations", "predicted_features"}
-ALL_TARGETS.extend(
-    f"{RESULTS}/figures/{name}.{fmt}"
-    for name, spec in FIGURE_SPECS.items()
-    if spec.target == "all"
-    and not (ARCHIVE_STUDY and any(key.partition(":")[0] in RUN_INPUT_KINDS for key in spec.needs))
-    for fmt in FIGURE_FORMATS
-)
-# the figures of other targets (next_shot), by target
-TARGET_FIGURES = {}
-for _name, _spec in FIGURE_SPECS.items():
-    if _spec.target != "all":
-        TARGET_FIGURES.setdefault(_spec.target, []).extend(f"{RESULTS}/figures/{_name}.{fmt}" for fmt in FIGURE_FORMATS)
+# the figures of `all` (but those an archive study cannot make), and those of other targets (next_shot), by target
+FIGURES_OF_ALL, TARGET_FIGURES = figure_targets(PLAN, FIGURE_SPECS, FIGURE_FORMATS)
+ALL_TARGETS.extend(FIGURES_OF_ALL)

@@ -11,7 +11,7 @@ rule next_shot_design:
     input:
         posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
-        run_set_path("next_shot", "designs", "{shot}.parquet"),
+        PLAN.run_set_path("next_shot", "designs", "{shot}.parquet"),
     log:
         f"{LOGS}/next_shot/design/{{shot}}.log",
     benchmark:
@@ -44,8 +44,8 @@ rule suggest_shot:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(config, "suggest_shot"),
-        designs=lambda w, input: " ".join(f"{c}={p}" for c, p in zip(CANDIDATES, input.designs)),
-        features=lambda w, input: " ".join(f"{c}={p}" for c, p in zip(CANDIDATES, input.features)),
+        designs=lambda w, input: pairs(CANDIDATES, input.designs),
+        features=lambda w, input: pairs(CANDIDATES, input.features),
         rmse=lambda w, input: f"--emulator-rmse {input.rmse}" if input.rmse else "",
     shell:
         "shockcal suggest-shot --designs {params.designs} --features {params.features} {params.rmse}"

@@ -1,12 +1,12 @@
 # The realized check of the next-shot ranking (docs/next_shot.md, "The realized check"): each compared
-# candidate (design.smk's CHECK_PLANS) as the fourth shot of a derived study, its training runs (run set
+# candidate (PLAN.check_plans, planned when the workflow is read) as the fourth shot of a derived study, its training runs (run set
 # next_shot_check) and the truths' runs at every shot (run set next_shot_truth) through simulate.smk and
 # features.smk; an emulator on the first next_shot.check.n_training_runs rows of the three shots (baseline) and of
 # the four (each candidate); each truth calibrated by `shockcal calibrate-check` with every one; the summary.
 # Outside `all`: `make next-shot-check` (snakemake next_shot_check).
 
 CHECK_SECTION = config["next_shot"]["check"]
-CHECK_MODELS = ["baseline", *CHECK_PLANS]
+CHECK_MODELS = PLAN.check_models()
 
 
 rule next_shot_check_truths:
@@ -14,8 +14,8 @@ rule next_shot_check_truths:
     input:
         posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
-        truths=run_set_path("next_shot_truth", "design.parquet"),
-        designs=expand(run_set_path("next_shot_truth", "designs", "{shot}.parquet"), shot=list(CHECK_PLANS)),
+        truths=PLAN.run_set_path("next_shot_truth", "design.parquet"),
+        designs=expand(PLAN.run_set_path("next_shot_truth", "designs", "{shot}.parquet"), shot=list(PLAN.check_plans)),
     log:
         f"{LOGS}/next_shot_truth/design.log",
     benchmark:
@@ -24,8 +24,8 @@ rule next_shot_check_truths:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(config, "next_shot_check_truths"),
-        candidates=" ".join(CHECK_PLANS),
-        designs=lambda w, output: " ".join(f"{c}={p}" for c, p in zip(CHECK_PLANS, output.designs)),
+        candidates=" ".join(PLAN.check_plans),
+        designs=lambda w, output: pairs(PLAN.check_plans, output.designs),
     shell:
         "shockcal next-shot-check-truths --posterior {input.posterior} --candidates {params.candidates}"
         " --out {output.truths} --candidate-designs {params.designs} > {log} 2>&1"
@@ -35,13 +35,7 @@ rule next_shot_check_emulator:
     """The check's emulator of a model (baseline: the three shots; a candidate: the four), on the first
     next_shot.check.n_training_runs rows, with the study's emulator settings."""
     input:
-        design=lambda w: CHECK_PLANS[w.model]["design"] if w.model in CHECK_PLANS else DESIGN,
-        features=lambda w: [
-            *expand(rules.features.output[0], run_set="training", shot=SHOTS),
-            *expand(
-                rules.features.output[0], run_set="next_shot_check", shot=check_model_shots(w.model)[len(SHOTS) :]
-            ),
-        ],
+        unpack(lambda w: PLAN.check_emulator_inputs(w.model)),
     output:
         emulator=f"{RESULTS}/next_shot/check/{{model}}/emulator/emulator.json",
     log:
@@ -54,9 +48,9 @@ rule next_shot_check_emulator:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]
     params:
-        settings=check_model_settings("emulate"),
-        config=lambda w: check_model_config(w.model),
-        pairs=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(check_model_shots(w.model), input.features)),
+        settings=lambda w: stage_config(PLAN.check_model_study(w.model), "emulate"),
+        config=lambda w: PLAN.check_model_config_option(w.model),
+        pairs=lambda w, input: pairs(PLAN.check_model_shots(w.model), input.features),
         runs=CHECK_SECTION["n_training_runs"],
         out=lambda w, output: os.path.dirname(output.emulator),
     shell:
@@ -70,7 +64,9 @@ rule next_shot_check_calibrations:
     input:
         emulator=rules.next_shot_check_emulator.output.emulator,
         truths=rules.next_shot_check_truths.output.truths,
-        features=lambda w: expand(rules.features.output[0], run_set="next_shot_truth", shot=check_model_shots(w.model)),
+        features=lambda w: expand(
+            rules.features.output[0], run_set="next_shot_truth", shot=PLAN.check_model_shots(w.model)
+        ),
     output:
         trials=f"{RESULTS}/next_shot/check/{{model}}/trials.parquet",
         draws=f"{RESULTS}/next_shot/check/{{model}}/draws.parquet",
@@ -84,11 +80,11 @@ rule next_shot_check_calibrations:
         "../envs/shockcal.yaml"
     threads: 1
     params:
-        settings=check_model_settings("calibrate_check"),
-        config=lambda w: check_model_config(w.model),
+        settings=lambda w: stage_config(PLAN.check_model_study(w.model), "calibrate_check"),
+        config=lambda w: PLAN.check_model_config_option(w.model),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
-        shots=lambda w: " ".join(check_model_shots(w.model)),
-        features=lambda w, input: " ".join(f"{s}={f}" for s, f in zip(check_model_shots(w.model), input.features)),
+        shots=lambda w: " ".join(PLAN.check_model_shots(w.model)),
+        features=lambda w, input: pairs(PLAN.check_model_shots(w.model), input.features),
         trials=CHECK_SECTION["n_truths"],
         n_live=CHECK_SECTION["n_live"],
         n_eff=CHECK_SECTION["n_eff"],
@@ -106,7 +102,7 @@ rule next_shot_check_summary:
         ranking=rules.suggest_shot.output[0],
         posterior=expand(rules.calibrate.output.samples, name="joint"),
         baseline=expand(rules.next_shot_check_calibrations.output.draws, model="baseline"),
-        candidates=expand(rules.next_shot_check_calibrations.output.draws, model=list(CHECK_PLANS)),
+        candidates=expand(rules.next_shot_check_calibrations.output.draws, model=list(PLAN.check_plans)),
     output:
         check=f"{RESULTS}/next_shot/check.csv",
         summary=f"{RESULTS}/next_shot/check_summary.csv",
@@ -118,7 +114,7 @@ rule next_shot_check_summary:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(config, "next_shot_check_summary"),
-        candidates=lambda w, input: " ".join(f"{c}={p}" for c, p in zip(CHECK_PLANS, input.candidates)),
+        candidates=lambda w, input: pairs(PLAN.check_plans, input.candidates),
     shell:
         "shockcal next-shot-check-summary --ranking {input.ranking} --posterior {input.posterior}"
         " --baseline {input.baseline} --candidates {params.candidates} --out {output.check} > {log} 2>&1"

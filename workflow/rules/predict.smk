@@ -7,7 +7,7 @@ rule predict_design:
     input:
         posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
-        run_set_path("predict", "design.parquet"),
+        PLAN.run_set_path("predict", "design.parquet"),
     log:
         f"{LOGS}/predict/design.log",
     benchmark:
@@ -26,7 +26,7 @@ rule predict_emulator:
         emulator=rules.emulator.output.emulator,
         arrays=rules.emulator.output.arrays,
     output:
-        run_set_path("predict", "emulator.parquet"),
+        PLAN.run_set_path("predict", "emulator.parquet"),
     log:
         f"{LOGS}/predict/emulator.log",
     benchmark:
@@ -50,7 +50,7 @@ rule posterior_netcdf:
         weighted=rules.calibrate.output.weighted,
         predicted=lambda w: (
             expand(rules.features.output[0], run_set="predict", shot=SHOTS)
-            if w.name == "joint" and not ARCHIVE_STUDY
+            if w.name == "joint" and not PLAN.archive
             else []
         ),
     output:
@@ -65,11 +65,7 @@ rule posterior_netcdf:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(config, "calibrate"),  # the prior box; its digest is the file's config_digest
-        predicted=lambda w, input: (
-            "--predicted-features " + " ".join(f"{s}={f}" for s, f in zip(SHOTS, input.predicted))
-            if input.predicted
-            else ""
-        ),
+        predicted=lambda w, input: f"--predicted-features {pairs(SHOTS, input.predicted)}" if input.predicted else "",
     shell:
         "shockcal posterior-netcdf --posterior {input.samples} {params.predicted} --out {output} > {log} 2>&1"
 

@@ -2,6 +2,8 @@
 # summaries, evidence, cross-validation, the Sobol indices, the emulator on the posterior's predictive runs,
 # and the synthetic-truth coverage when `make check` has made it.
 
+COVERAGE = existing_coverage(CHECK_TRUTHS, CHECK_TARGETS)
+
 
 rule report_tables:
     input:
@@ -28,7 +30,7 @@ rule report_tables:
     conda:
         "../envs/shockcal.yaml"
     params:
-        posteriors=lambda w, input: " ".join(f"{n}={p}" for n, p in zip(CALIBRATIONS, input.posteriors)),
+        posteriors=lambda w, input: pairs(CALIBRATIONS, input.posteriors),
         out_dir=lambda w, output: os.path.dirname(output.summary),
     shell:
         "shockcal report-tables --posteriors {params.posteriors} --cv-rmse {input.cv_rmse} --sobol {input.sobol}"
@@ -47,8 +49,8 @@ rule report_coverage:
     conda:
         "../envs/shockcal.yaml"
     params:
-        coverage=" ".join(f"{t}={p}" for t, p in zip(CHECK_TRUTHS, CHECK_TARGETS) if os.path.exists(p)),
-        modified=[int(os.path.getmtime(p)) if os.path.exists(p) else None for p in CHECK_TARGETS],
+        coverage=COVERAGE["pairs"],
+        modified=COVERAGE["modified"],
         out_dir=lambda w, output: os.path.dirname(output[0]),
     shell:
         "shockcal report-tables --coverage {params.coverage} --out-dir {params.out_dir} > {log} 2>&1"
@@ -58,7 +60,7 @@ rule report_heldout:
     """The study's emulator on the posterior's predictive runs, which no fit saw: where the calibration uses it."""
     input:
         emulator=rules.emulator.output.emulator,
-        design=run_set_path("predict", "design.parquet"),
+        design=PLAN.run_set_path("predict", "design.parquet"),
         features=expand(rules.features.output[0], run_set="predict", shot=SHOTS),
     output:
         report(
@@ -81,8 +83,8 @@ rule report_heldout:
 
 
 ALL_TARGETS.extend(rules.report_tables.output)
-if not ARCHIVE_STUDY:  # an archive study runs no predictive runs
+if not PLAN.archive:  # an archive study runs no predictive runs
     ALL_TARGETS.extend(rules.report_heldout.output)
 # the coverage checks are outside `all` (make check); their table joins the report once one exists
-if any(os.path.exists(path) for path in CHECK_TARGETS):
+if COVERAGE["pairs"]:
     ALL_TARGETS.extend(rules.report_coverage.output)

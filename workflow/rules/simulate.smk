@@ -1,14 +1,23 @@
-# Simulate: every run set (training, predict, check) the same way, one job per run set, shot and chunk
-# of design rows, under {RESULTS}/{run_set}/simulations/. The training design is made when the workflow
-# is read (design.smk) and is an `ancient` input: a training chunk reruns when its own rows
-# (params.rows_digest: their run ids and the columns this shot reads) or the physics change, not when
-# the design file is rewritten with the same rows or gains another shot's column. The predict and check
-# designs are made by jobs (predict.smk, calibrate.smk), and their chunks follow them.
+# Run sets: every set of hydrocode runs goes through the same rules (simulate.smk, features.smk) and the same
+# paths, {RESULTS}/{run_set}/{design.parquet, simulations/, features/}, in chunks of design rows (their sizes,
+# chunks and order: the plan, src/shockcal/study/workflow_plan.py):
+#   training: the training design (the seeded Latin hypercube over the prior box, or the config's design file),
+#             written when the workflow is read (the Snakefile), for the emulator;
+#   predict:  predict.n_posterior_runs seeded joint-posterior draws (Figs 10-13; predict.smk);
+#   check, check_posterior: calibration.check.trials truths for the synthetic-truth checks (calibrate.smk);
+#   next_shot: next_shot.n_draws joint-posterior draws at each next-shot candidate, whose names take the
+#             shots' place (next_shot.smk);
+#   wave1, wave2, ...: a sequential study's later waves (waves.smk), the training run set is then wave 0;
+#   next_shot_check, next_shot_truth: the realized check's candidates' training runs and truths
+#             (next_shot_check.smk); new_shot: each new shot's own runs (design.new_shots; waves.smk).
+# The training design and a check candidate's are `ancient` inputs: a training chunk reruns when its own rows
+# (params.rows_digest: their run ids and the columns this shot reads) or the physics change, not when the design
+# file is rewritten with the same rows or gains another shot's column. The other designs are made by jobs.
 
 
 rule simulate:
     input:
-        design=run_set_design,
+        design=lambda w: PLAN.design_input(w.run_set, w.shot),
     output:
         f"{RESULTS}/{{run_set}}/simulations/{{shot}}/chunk-{{chunk}}.parquet",
     log:
@@ -16,24 +25,17 @@ rule simulate:
     benchmark:
         f"{BENCHMARKS}/{{run_set}}/simulate/{{shot}}/chunk-{{chunk}}.tsv"
     wildcard_constraints:
-        run_set="|".join(RUN_SET_SIZES),
-    priority: simulate_priority  # longest chunk first, before figures and observed (common.smk)
+        run_set="|".join(PLAN.run_set_sizes),
+    # longest chunk first, before figures and observed (docs/workflow.md, "Job order")
+    priority: lambda w: PLAN.simulate_priority(w.run_set, w.shot, w.chunk)
     conda:
         "../envs/shockcal.yaml"
     params:
         settings=run_set_settings("simulate"),
-        rows=lambda w: chunk_rows(
-            w.chunk,
-            RUN_SET_CHUNK_SIZE[w.run_set],
-            RUN_SET_SIZES[w.run_set] if w.run_set == "next_shot_check" else None,
-        ),
-        rows_digest=lambda w: (
-            CHUNK_DIGESTS[w.shot][int(w.chunk)]
-            if w.run_set == "training"
-            else CHECK_DIGESTS[w.shot][int(w.chunk)] if w.run_set == "next_shot_check" else ""
-        ),
+        rows=lambda w: PLAN.chunk_rows(w.run_set, w.chunk),
+        rows_digest=lambda w: PLAN.rows_digest(w.run_set, w.shot, w.chunk),
         end_time=lambda w: f"--end-time-us {config['predict']['end_time_us']}" if w.run_set == "predict" else "",
-        allow_empty=allow_empty,
+        allow_empty=lambda w: PLAN.allow_empty(w.run_set),
     shell:
         "shockcal simulate --shot {wildcards.shot} --design {input.design}"
         " --rows {params.rows} {params.end_time} {params.allow_empty} --out {output} > {log} 2>&1"

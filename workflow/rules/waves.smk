@@ -10,9 +10,8 @@
 #   {RESULTS}/wave{k}/{design.parquet, simulations/, features/}: wave k's runs (the run set "wave{k}")
 #   {RESULTS}/waves/step{k}/{design.parquet, features/}: every run of waves 0..k
 #   {RESULTS}/waves/step{k}/{emulator/, posterior/}: their emulator and joint posterior (k before the last)
+# (the waves, steps and their files: PLAN, src/shockcal/study/workflow_plan.py)
 
-WAVE_RUN_SETS = ["training", *WAVES]  # wave 0 is the training run set
-LAST_STEP = len(WAVES)
 # a step's posterior only places the next wave: a lighter sampler (design.waves.step_calibration)
 STEP_SAMPLER = "--n-live {n_live} --n-eff {n_eff}".format(**config["design"]["waves"]["step_calibration"])
 
@@ -20,11 +19,11 @@ STEP_SAMPLER = "--n-live {n_live} --n-eff {n_eff}".format(**config["design"]["wa
 rule merge_runs:
     """Every run of waves 0..step: one design, one features table per shot."""
     input:
-        designs=lambda w: [wave_design_path(k) for k in range(int(w.step) + 1)],
-        features=lambda w: step_features(w.step),
+        designs=lambda w: [PLAN.wave_design_path(k) for k in range(int(w.step) + 1)],
+        features=lambda w: PLAN.step_features(w.step),
     output:
-        design=step_path("{step}", "design.parquet"),
-        features=[step_path("{step}", "features", f"{shot}.parquet") for shot in BASE_SHOTS],
+        design=PLAN.step_file("{step}", "design"),
+        features=[PLAN.step_path("{step}", "features", f"{shot}.parquet") for shot in PLAN.base_shots],
     log:
         f"{LOGS}/waves/step{{step}}/merge_runs.log",
     benchmark:
@@ -34,9 +33,9 @@ rule merge_runs:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(BASE_STUDY, "merge_runs"),
-        pairs=lambda w, input: pairs(BASE_SHOTS * (int(w.step) + 1), input.features),
-        out=lambda w: step_path(w.step),
+        settings=stage_config(PLAN.base_study, "merge_runs"),
+        pairs=lambda w, input: pairs(PLAN.base_shots * (int(w.step) + 1), input.features),
+        out=lambda w: PLAN.step_path(w.step),
     shell:
         "shockcal merge-runs --designs {input.designs} --features {params.pairs} --out {params.out} > {log} 2>&1"
 
@@ -47,8 +46,8 @@ rule wave_emulator:
         design=rules.merge_runs.output.design,
         features=rules.merge_runs.output.features,
     output:
-        emulator=step_path("{step}", "emulator", "emulator.json"),
-        arrays=step_path("{step}", "emulator", "emulator.npz"),
+        emulator=PLAN.step_file("{step}", "emulator"),
+        arrays=PLAN.step_file("{step}", "arrays"),
     log:
         f"{LOGS}/waves/step{{step}}/emulator.log",
     benchmark:
@@ -59,8 +58,8 @@ rule wave_emulator:
         "../envs/shockcal.yaml"
     threads: config["emulator"]["n_jobs"]
     params:
-        settings=stage_config(BASE_STUDY, "emulate"),
-        pairs=lambda w, input: pairs(BASE_SHOTS, input.features),
+        settings=stage_config(PLAN.base_study, "emulate"),
+        pairs=lambda w, input: pairs(PLAN.base_shots, input.features),
         out=lambda w, output: os.path.dirname(output.emulator),
     shell:
         "shockcal emulate --design {input.design} --features {params.pairs} --no-cv --out {params.out} > {log} 2>&1"
@@ -72,9 +71,9 @@ rule wave_calibrate:
         emulator=rules.wave_emulator.output.emulator,
         observed=rules.observed_base.output[0],
     output:
-        samples=step_path("{step}", "posterior", "joint.parquet"),
-        summary=step_path("{step}", "posterior", "joint_summary.parquet"),
-        weighted=step_path("{step}", "posterior", "joint_weighted.parquet"),
+        samples=PLAN.step_file("{step}", "samples"),
+        summary=PLAN.step_file("{step}", "summary"),
+        weighted=PLAN.step_file("{step}", "weighted"),
     log:
         f"{LOGS}/waves/step{{step}}/calibrate.log",
     benchmark:
@@ -85,9 +84,9 @@ rule wave_calibrate:
         "../envs/shockcal.yaml"
     threads: 1  # as the study's calibrations (calibrate.smk)
     params:
-        settings=stage_config(BASE_STUDY, "calibrate"),
+        settings=stage_config(PLAN.base_study, "calibrate"),
         sampler=STEP_SAMPLER,
-        shots=" ".join(BASE_SHOTS),
+        shots=" ".join(PLAN.base_shots),
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
         "shockcal calibrate --emulator {params.emulator_dir} --shots {params.shots} {params.sampler}"
@@ -98,7 +97,7 @@ rule wave_design:
     """A later wave's design: the previous joint posterior thinned (design.waves.criterion), or no runs
     once the posterior stopped moving (design.waves.stop_mcse)."""
     input:
-        unpack(wave_design_inputs),
+        unpack(lambda w: PLAN.wave_design_inputs(w.wave)),
     output:
         f"{RESULTS}/wave{{wave}}/design.parquet",
     log:
@@ -110,7 +109,7 @@ rule wave_design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(BASE_STUDY, "wave_design"),
+        settings=stage_config(PLAN.base_study, "wave_design"),
         earlier=lambda w, input: f"--earlier-summary {input.earlier}" if "earlier" in input.keys() else "",
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
@@ -124,16 +123,16 @@ rule new_shot_design:
     training runs alone, without waves) thinned, the shot's own inputs drawn fresh. Its settings are the base
     study's and this shot's alone (`new_shot_config`), so adding another shot reruns none of its runs."""
     input:
-        posterior=rules.wave_calibrate.output.samples.format(step=LAST_STEP),
-        runs=rules.merge_runs.output.design.format(step=LAST_STEP),
+        posterior=PLAN.step_file(PLAN.last_step, "samples"),
+        runs=PLAN.step_file(PLAN.last_step, "design"),
     output:
-        run_set_path("new_shot", "designs", "{shot}.parquet"),
+        PLAN.run_set_path("new_shot", "designs", "{shot}.parquet"),
     log:
         f"{LOGS}/new_shot/design/{{shot}}.log",
     benchmark:
         f"{BENCHMARKS}/new_shot/design/{{shot}}.tsv"
     wildcard_constraints:
-        shot="|".join(NEW_SHOTS) or "^$",
+        shot="|".join(PLAN.new_shots) or "^$",
     conda:
         "../envs/shockcal.yaml"
     params:
@@ -141,11 +140,3 @@ rule new_shot_design:
     shell:
         "shockcal new-shot-design --shot {wildcards.shot} --posterior {input.posterior} --runs {input.runs}"
         " --out {output} > {log} 2>&1"
-
-
-# the study's emulator (emulator.smk) is fitted on these runs: the base shots' on one design, each new shot's on its own
-STUDY_RUNS = {
-    "design": rules.merge_runs.output.design.format(step=LAST_STEP) if WAVES else DESIGN,
-    "features": [study_features(shot) for shot in SHOTS],
-    "shot_designs": [run_set_path("new_shot", "designs", f"{shot}.parquet") for shot in NEW_SHOTS],
-}
