@@ -10,6 +10,7 @@
 # simulate.chunk_size design rows:
 #   training: the design below, for the emulator;
 #   predict:  predict.n_posterior_runs seeded joint-posterior draws (Figs 10-13; predict.smk);
+#   verify:   verify.n_draws seeded joint-posterior draws, the hydrocode's verdict (`make verify`; verify.smk);
 #   check:    calibration.check.trials truths on a Latin hypercube over the box, for the synthetic-truth
 #             check with hydrocode-made pseudo-measurements (calibrate.smk);
 #   next_shot: next_shot.n_draws joint-posterior draws at each next-shot candidate, whose names take the
@@ -34,6 +35,7 @@ RUN_SET_SIZES = {
     "check": config["calibration"]["check"]["trials"],
     "check_posterior": config["calibration"]["check"]["trials"],
     "next_shot": config["next_shot"]["n_draws"],
+    "verify": config["verify"]["n_draws"],  # the hydrocode's verdict (verify.smk)
 }
 WAVES = [f"wave{k}" for k in range(1, len(wave_sizes(config)))]  # none with design.strategy: lhs
 RUN_SET_SIZES.update(zip(WAVES, wave_sizes(config)[1:]))
