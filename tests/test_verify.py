@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from shockcal.errors import InputError
+from shockcal.errors import ConfigError, InputError
 from shockcal.inference.problem import Problem
 from shockcal.inference.verify import VerifySettings, corrected_quantiles, khat_threshold, psis_verdict
+from shockcal.study.validate import validate_config
 
 S = 4000
 
@@ -56,7 +57,11 @@ def test_khat_threshold_follows_the_number_of_draws():
     assert khat_threshold(5000) == 0.7
 
 
-def test_bad_input_is_refused_in_one_line():
+def test_bad_input_is_refused_in_one_line(paper_config):
+    """The library refuses what the config refuses: fewer than 20 draws, in one line naming the key."""
+    paper_config["verify"] = {"n_draws": 10}
+    with pytest.raises(ConfigError, match=r"verify\.n_draws: 10 is less than the minimum of 20"):
+        validate_config(paper_config, source="config.yaml")
     with pytest.raises(InputError, match="verify.n_draws: 10 is not an integer >= 20"):
         VerifySettings(10)
     with pytest.raises(InputError, match="one of each per draw"):
