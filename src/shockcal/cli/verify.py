@@ -70,7 +70,7 @@ def run(args) -> int:
 
     log = logging.getLogger("shockcal.verify")
     config = load_stage_config(args.config, "verify")
-    VerifySettings(config["verify"]["n_draws"])
+    settings = VerifySettings(config["verify"]["n_draws"])
     emulator = study_emulator(args.emulator, config)
     shots = list(config["shots"])
     units = {name: box["unit"] for name, box in config["inputs"].items()}
@@ -78,6 +78,9 @@ def run(args) -> int:
                                 args.observed, prior_bounds(config), units)
     design = load_study_design(args.design, config, problem.names)
     require_columns(design, [LAMBDA_Y], args.design)
+    if len(design) != settings.n_draws:
+        raise InputError(f"{args.design}: {len(design)} draws, verify.n_draws is {settings.n_draws}; "
+                         "redraw them (`shockcal predict --stream verify --n-runs`)")
     features, ok = hydrocode_features(parse_pairs(args.features, "--features"), shots, emulator.feature_names,
                                       design["run"].to_numpy())
     if not ok.all():
