@@ -76,8 +76,10 @@ def run(args) -> int:
     units = {name: box["unit"] for name, box in config["inputs"].items()}
     problem = Problem.for_shots(emulator, shots, read_table(args.observed), config["observed"]["sd_fraction"],
                                 args.observed, prior_bounds(config), units)
-    design = load_study_design(args.design, config, problem.names)
-    require_columns(design, [LAMBDA_Y], args.design)
+    design = load_study_design(args.design, config, problem.names)   # checked against the box; lambda_y beside it
+    lambda_y = read_table(args.design)
+    require_columns(lambda_y, ["run", LAMBDA_Y], args.design)
+    design[LAMBDA_Y] = lambda_y.set_index("run")[LAMBDA_Y].reindex(design["run"]).to_numpy(float)
     if len(design) != settings.n_draws:
         raise InputError(f"{args.design}: {len(design)} draws, verify.n_draws is {settings.n_draws}; "
                          "redraw them (`shockcal predict --stream verify --n-runs`)")
