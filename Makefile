@@ -27,7 +27,7 @@ define study
 endef
 
 .DEFAULT_GOAL := help
-.PHONY: help env study paper quick flag-archive models models-paper models-reduced models-quick check next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: help env study paper quick flag-archive models models-paper models-reduced models-quick check verify next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
 
 help:  ## these targets, one line each
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
@@ -107,6 +107,10 @@ check: $(INSTALLED)  ## synthetic-truth coverage checks of the study (calibratio
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) check $(STUDY_CONFIG)
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
 	@echo "report:  their table joins $(CURDIR)/$(STUDY_DIR)/report.html at the next make study$(if $(filter paper,$(STUDY)), STUDY=paper)"
+
+verify: $(INSTALLED)  ## the hydrocode's verdict on the joint posterior: verify.n_draws draws run, PSIS k-hat, corrected quantiles (STUDY=paper: the paper's)
+	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) verify $(STUDY_CONFIG)
+	@echo "results: $(CURDIR)/$(STUDY_DIR)/verify/summary.csv (the verdict: $(STUDY_DIR)/logs/verify/summary.log)"
 
 next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain (STUDY=paper: on the paper's study)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot $(STUDY_CONFIG)

@@ -67,7 +67,7 @@ def test_reruns_come_from_the_stage_declarations():
         "features (its shot); failure_budget (its shot); observed; next_shot_design; next_shot_simulate; "
         "next_shot_features; next_shot_check_truths; figures ")
     assert "simulate (shots that read it)" in reruns(("inputs", "<input>", "min"))
-    assert reruns(("observed", "sd_fraction")) == ("calibrate; calibrate_check; wave_design; suggest_shot; "
+    assert reruns(("observed", "sd_fraction")) == ("calibrate; calibrate_check; wave_design; verify; suggest_shot; "
                                                    "figures 9, 10, features_vs_training")
     assert reruns(("figures", "dpi")) == "figures"
     # a toy declaration: prefixes either way, wildcards, the job's shot

@@ -23,6 +23,7 @@ keyed further (an emulator block index, a calibration's shots).
 | waves | a sequential study's later waves: the posterior pool of wave k ("pool", k) |
 | check_posterior | the joint-posterior draws the posterior-truth check takes as truths (`shockcal predict --stream`) |
 | new_shot | a new shot's runs (`design.new_shots`): the posterior pool, keyed by shot; its own inputs, by shot and input |
+| verify | the joint-posterior draws the hydrocode's verdict runs (`make verify`; `shockcal predict --stream`) |
 """
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ import numpy as np
 
 STREAMS = ("emulator", "calibration", "check", "check_design", "posterior_draws", "figures", "design_extension",
            "sensitivity", "readout", "next_shot", "replicate", "waves", "check_posterior",
-           "new_shot")
+           "new_shot", "verify")
 
 
 def stream_seed(study_seed: int, name: str, *keys: int | str) -> int:

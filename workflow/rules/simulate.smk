@@ -4,6 +4,7 @@
 #   training: the training design (the seeded Latin hypercube over the prior box, or the config's design file),
 #             written when the workflow is read (the Snakefile), for the emulator;
 #   predict:  predict.n_posterior_runs seeded joint-posterior draws (Figs 10-13; predict.smk);
+#   verify:   verify.n_draws seeded joint-posterior draws, the hydrocode's verdict (`make verify`; verify.smk);
 #   check, check_posterior: calibration.check.trials truths for the synthetic-truth checks (calibrate.smk);
 #   next_shot: next_shot.n_draws joint-posterior draws at each next-shot candidate, whose names take the
 #             shots' place (next_shot.smk);

@@ -25,6 +25,7 @@ STAGE_MODULES = [
     "shockcal.cli.calibrate",
     "shockcal.cli.posterior_netcdf",
     "shockcal.cli.predict",
+    "shockcal.cli.verify",
     "shockcal.cli.waves",
     "shockcal.cli.next_shot",
     "shockcal.cli.next_shot_check",

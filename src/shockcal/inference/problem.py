@@ -146,6 +146,15 @@ class Problem:
                              "(the emulator's prediction or covariance is invalid there)")
         return value
 
+    def hydrocode_log_likelihood(self, features: np.ndarray, lambda_y: np.ndarray) -> np.ndarray:
+        """Log-likelihood of the observed features when the predicted features are known exactly (a
+        hydrocode run's, (N, F) m/s, in the problem's feature order) at lambda_y (N,): the noise of
+        `log_likelihood` (obs_sd^2 / lambda_y), without the emulator's share. NaN where a feature is NaN."""
+        features, lam = np.atleast_2d(np.asarray(features, dtype=float)), np.asarray(lambda_y, dtype=float)
+        noise_var = self.obs_sd ** 2 / lam[:, None]
+        return ErrorModel().log_density(self.observed - features, np.zeros((*features.shape, features.shape[1])),
+                                        noise_var)
+
     def log_posterior(self, x: np.ndarray) -> np.ndarray:
         """Log posterior (up to a constant) at x (N, d + 1) = (theta, log lambda_y); -inf outside the
         box. The Gamma prior of lambda_y and the Jacobian of the log are included."""

@@ -271,6 +271,7 @@ def run_set_sizes(config: dict, training_runs: int) -> dict[str, int]:
         "check": config["calibration"]["check"]["trials"],
         "check_posterior": config["calibration"]["check"]["trials"],
         "next_shot": config["next_shot"]["n_draws"],
+        "verify": config["verify"]["n_draws"],
     }
     waves = wave_sizes(config)
     sizes.update(zip((f"wave{k}" for k in range(1, len(waves))), waves[1:]))

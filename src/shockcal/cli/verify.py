@@ -1,0 +1,102 @@
+"""`shockcal verify`: the hydrocode's verdict on the joint posterior (shockcal.inference.verify).
+
+Reads the verify run set's design (`shockcal predict --stream verify`: S joint-posterior draws with their
+lambda_y), the hydrocode's features at those draws per shot, the emulator and the observed features; writes
+`--out` (CSV: per calibrated input, user units, the emulator's and the corrected 5/50/95% points, k-hat and
+its threshold) and logs the one-line verdict.
+"""
+
+from __future__ import annotations
+
+from shockcal.cli import add_command, add_config_argument
+
+EXAMPLE_VERIFY = """\
+shockcal verify --config config/config.yaml --design results/verify/design.parquet \\
+    --features 104S=results/verify/features/104S.parquet 105S=results/verify/features/105S.parquet \\
+    --emulator results/emulator --observed results/features/observed.parquet --out results/verify/summary.csv"""
+
+
+def register(subparsers) -> None:
+    p = add_command(subparsers, "verify", example=EXAMPLE_VERIFY,
+                    help="the hydrocode's verdict on the joint posterior: PSIS k-hat and corrected quantiles")
+    add_config_argument(p)
+    p.add_argument("--design", required=True, help="the draws run (`shockcal predict --stream verify`)")
+    p.add_argument("--features", required=True, nargs="+", metavar="SHOT=TABLE",
+                   help="the hydrocode's features at the draws, one table per shot")
+    p.add_argument("--emulator", required=True, help="emulator directory written by `shockcal emulate`")
+    p.add_argument("--observed", required=True, help="observed features table")
+    p.add_argument("--out", required=True, help="output CSV summary")
+    p.set_defaults(func=run)
+
+
+def hydrocode_features(tables: dict, shots: list[str], feature_names: list[str], runs) -> tuple:
+    """The (S, shots x features) hydrocode features at design `runs`, shot-major, and a mask of the draws every
+    shot's run gave features for (a failed run: status not ok, or a missing row)."""
+    import numpy as np
+
+    from shockcal.errors import InputError
+    from shockcal.io import read_table
+
+    blocks = []
+    for shot in shots:
+        if shot not in tables:
+            raise InputError(f"--features: no table for shot {shot} (have {sorted(tables)})")
+        table = read_table(tables[shot])
+        missing = [c for c in ["run", *feature_names] if c not in table.columns]
+        if missing:
+            raise InputError(f"{tables[shot]}: columns {missing} missing")
+        if "status" in table.columns:
+            table = table[table["status"].eq("ok")]
+        block = table.set_index("run").reindex(runs)[feature_names].to_numpy(float)
+        blocks.append(block)
+    features = np.concatenate(blocks, axis=1)
+    return features, np.isfinite(features).all(axis=1)
+
+
+def run(args) -> int:
+    import logging
+
+    import numpy as np
+
+    from shockcal.cli import parse_pairs
+    from shockcal.cli.calibrate import study_emulator
+    from shockcal.errors import InputError
+    from shockcal.inference.problem import LAMBDA_Y, Problem
+    from shockcal.inference.verify import VerifySettings, corrected_quantiles, psis_verdict
+    from shockcal.io import read_table, require_columns
+    from shockcal.study.adapters import load_study_design
+    from shockcal.study.config import input_columns, input_user_units, prior_bounds
+    from shockcal.study.stages import load_stage_config
+
+    log = logging.getLogger("shockcal.verify")
+    config = load_stage_config(args.config, "verify")
+    settings = VerifySettings(config["verify"]["n_draws"])
+    emulator = study_emulator(args.emulator, config)
+    shots = list(config["shots"])
+    units = {name: box["unit"] for name, box in config["inputs"].items()}
+    problem = Problem.for_shots(emulator, shots, read_table(args.observed), config["observed"]["sd_fraction"],
+                                args.observed, prior_bounds(config), units)
+    design = load_study_design(args.design, config, problem.names)   # checked against the box; lambda_y beside it
+    lambda_y = read_table(args.design)
+    require_columns(lambda_y, ["run", LAMBDA_Y], args.design)
+    design[LAMBDA_Y] = lambda_y.set_index("run")[LAMBDA_Y].reindex(design["run"]).to_numpy(float)
+    if len(design) != settings.n_draws:
+        raise InputError(f"{args.design}: {len(design)} draws, verify.n_draws is {settings.n_draws}; "
+                         "redraw them (`shockcal predict --stream verify --n-runs`)")
+    features, ok = hydrocode_features(parse_pairs(args.features, "--features"), shots, emulator.feature_names,
+                                      design["run"].to_numpy())
+    if not ok.all():
+        log.warning("%d of %d draws have a failed hydrocode run at some shot; verifying on the other %d",
+                    int((~ok).sum()), len(ok), int(ok.sum()))
+    if not ok.any():
+        raise InputError(f"{args.design}: no draw has features at every shot")
+    points = design.loc[ok, [*problem.names, LAMBDA_Y]].to_numpy(float)
+    verdict = psis_verdict(problem.hydrocode_log_likelihood(features[ok], points[:, -1]),
+                           problem.log_likelihood(points))
+    columns = input_columns(config)
+    user = points[:, :-1] * np.array([columns[name][2] for name in problem.names])
+    table = corrected_quantiles(user, [columns[name][0] for name in problem.names], verdict)
+    table.insert(1, "unit", [input_user_units(config)[name] for name in problem.names])
+    table.to_csv(args.out, index=False)
+    log.info("%s\n%s", verdict.line(), table.to_string(index=False, float_format="%.4g"))
+    return 0
