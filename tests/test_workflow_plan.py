@@ -54,7 +54,7 @@ def with_new_shot(tmp_path: Path, name: str = "quick.yaml") -> dict:
 
 def test_run_sets_and_their_chunks(tmp_path):
     plan = plan_workflow(study(tmp_path))
-    assert list(plan.run_set_sizes) == ["training", "predict", "check", "check_posterior", "next_shot",
+    assert list(plan.run_set_sizes) == ["training", "predict", "check", "check_posterior", "next_shot", "verify",
                                         "next_shot_check", "next_shot_truth", "new_shot"]
     assert plan.run_set_sizes["training"] == 40 and plan.run_set_chunks["training"] == [0, 1, 2, 3]
     assert plan.run_set_chunks["predict"] == [0] and plan.run_set_chunks["next_shot"] == [0, 1]

@@ -8,7 +8,7 @@ rule verify_design:
     input:
         posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
-        run_set_path("verify", "design.parquet"),
+        PLAN.run_set_path("verify", "design.parquet"),
     log:
         f"{LOGS}/verify/design.log",
     benchmark:
@@ -32,7 +32,7 @@ rule verify:
         arrays=rules.emulator.output.arrays,
         observed=rules.observed.output[0],
     output:
-        run_set_path("verify", "summary.csv"),
+        PLAN.run_set_path("verify", "summary.csv"),
     log:
         f"{LOGS}/verify/summary.log",
     benchmark:
