@@ -15,7 +15,9 @@ def _box_transform(lower, upper):
     return lambda u: lower + u * (upper - lower)
 
 
-@pytest.mark.parametrize("cube_power", [None, [2.0, 1.0, 3.0]])
+# without powers in `make test-slow` (15-30 s): the fast suite keeps the run with powers (the same nautilus run
+# with the warp on top) and the unwarped path's exact posterior through tests/test_calibration.py's linear Gaussian
+@pytest.mark.parametrize("cube_power", [pytest.param(None, marks=pytest.mark.slow), [2.0, 1.0, 3.0]])
 def test_linear_gaussian_posterior_mean_covariance_and_evidence(cube_power):
     # y = X theta + e, e ~ N(0, s^2 I), flat prior on a box far wider than the posterior:
     # posterior N((X'X)^-1 X'y, s^2 (X'X)^-1), evidence = Gaussian integral / box volume.
