@@ -50,6 +50,7 @@ def test_linear_gaussian_posterior_mean_covariance_and_evidence(cube_power):
     assert draws.n_likelihood > 2000
 
 
+@pytest.mark.slow   # 8-15 s; the fast suite's two modes: tests/test_calibration.py's (the same sampler, through Problem)
 def test_two_modes_found_in_the_right_proportion():
     # Mixture 0.3 N(-3, 0.5) + 0.7 N(3, 0.5) in x1, x2 ~ N(0, 1): the barrier is ~18 nats deep.
     def log_likelihood(theta):
@@ -74,6 +75,8 @@ def test_a_run_short_of_its_target_at_the_evaluation_limit_is_an_error():
                       max_evaluations=1000)
 
 
+# 9-13 s; the fast suite's same-seed runs: tests/test_progress.py (points and weights), tests/test_calibration.py
+@pytest.mark.slow   # (the resampled draws)
 def test_same_seed_gives_identical_draws():
     def log_likelihood(theta):
         return -0.5 * np.sum((theta - 0.3) ** 2, axis=1) / 0.01
