@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pandas as pd
@@ -13,6 +11,7 @@ import pytest
 
 from shockcal.campaign.box_sensitivity import BoxSensitivity
 from shockcal.campaign.model_comparison import COLUMNS, ModelResult, evidence_table
+from shockcal.cli import main
 from shockcal.errors import InputError
 from shockcal.io import write_table
 
@@ -62,15 +61,22 @@ def _study(tmp_path, name, log_z, sd, kfold, outer=None):
     return root
 
 
-def test_command_reads_each_study(tmp_path):
+def compare_models(capsys, *args) -> tuple[int, str]:
+    """`shockcal compare-models ARGS` in this process (a `python -m shockcal` costs seconds of imports):
+    its exit code and what it printed to stderr."""
+    code = main(["compare-models", *map(str, args)])
+    return code, capsys.readouterr().err
+
+
+def test_command_reads_each_study(tmp_path, capsys, caplog):
     jc = _study(tmp_path, "jc", -45.0, 0.03, 12.4, 21.0)
     za = _study(tmp_path, "za", -47.0, 0.04, 11.0, 19.0)
     ptw = _study(tmp_path, "ptw", -46.0, 0.05, 30.0)                   # no outer check: too few runs inside
     out = tmp_path / "models" / "evidence.csv"
-    done = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
-                           "--model", f"zerilli-armstrong={za}", "--model", f"ptw={ptw}", "--out", str(out),
-                           "--figures-dir", str(tmp_path / "models" / "figures")], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    with caplog.at_level("WARNING"):
+        code, err = compare_models(capsys, "--model", f"jc={jc}", "--model", f"zerilli-armstrong={za}", "--model",
+                                   f"ptw={ptw}", "--out", out, "--figures-dir", tmp_path / "models" / "figures")
+    assert code == 0, err
     assert (tmp_path / "models" / "figures" / "evidence.png").is_file()
     table = pd.read_csv(out).set_index("model")
     za_row = table.loc["zerilli-armstrong"]
@@ -83,26 +89,23 @@ def test_command_reads_each_study(tmp_path):
     assert table.loc["zerilli-armstrong", "log_bf_vs_johnson_cook"] == pytest.approx(-2.0)
     assert table.loc["zerilli-armstrong", "kfold_rmse_m_s"] == 11.0
     assert table.loc["zerilli-armstrong", "log_bf_sd"] == pytest.approx(math.hypot(0.03, 0.04))
-    assert math.isnan(table.loc["ptw", "outer_rmse_m_s"]) and "ptw" in done.stderr and "no outer check" in done.stderr
+    assert math.isnan(table.loc["ptw", "outer_rmse_m_s"]) and "ptw" in caplog.text and "no outer check" in caplog.text
     assert table["heldout_rmse_m_s"].isna().all() and table["heldout_coverage"].isna().all()   # no predictive runs
-    missing = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
-                              "--model", f"ptw={tmp_path / 'nowhere'}", "--out", str(out)], capture_output=True, text=True)
-    assert missing.returncode != 0
-    assert "--model ptw:" in missing.stderr and "joint.parquet does not exist" in missing.stderr
-    assert "Traceback" not in missing.stderr
+    code, err = compare_models(capsys, "--model", f"jc={jc}", "--model", f"ptw={tmp_path / 'nowhere'}", "--out", out)
+    assert code != 0
+    assert "--model ptw:" in err and "joint.parquet does not exist" in err
+    assert "Traceback" not in err
     (za / "emulator" / "emulator.json").write_text(json.dumps({"input_bounds": {"V1": [0.01, 0.03]}}))
-    no_box = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
-                             "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
-    assert no_box.returncode != 0 and "Traceback" not in no_box.stderr
-    assert "--model zerilli-armstrong:" in no_box.stderr and "input_bounds has no a" in no_box.stderr
+    code, err = compare_models(capsys, "--model", f"jc={jc}", "--model", f"za={za}", "--out", out)
+    assert code != 0 and "Traceback" not in err
+    assert "--model zerilli-armstrong:" in err and "input_bounds has no a" in err
     (za / "emulator" / "emulator.json").write_text("{not json")
-    damaged = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"jc={jc}",
-                              "--model", f"za={za}", "--out", str(out)], capture_output=True, text=True)
-    assert damaged.returncode != 0 and "Traceback" not in damaged.stderr
-    assert "emulator.json: not an emulator's JSON description" in damaged.stderr
+    code, err = compare_models(capsys, "--model", f"jc={jc}", "--model", f"za={za}", "--out", out)
+    assert code != 0 and "Traceback" not in err
+    assert "emulator.json: not an emulator's JSON description" in err
 
 
-def test_the_emulator_on_each_laws_predictive_runs_joins_its_row(tmp_path):
+def test_the_emulator_on_each_laws_predictive_runs_joins_its_row(tmp_path, capsys, caplog):
     """A study with report/emulator_heldout.csv (the emulator on its posterior's predictive runs): its overall row's
     RMSE and band coverage; a table without that row is one line naming the file."""
     jc = _study(tmp_path, "jc", -45.0, 0.03, 12.4, 21.0)
@@ -112,13 +115,12 @@ def test_the_emulator_on_each_laws_predictive_runs_joins_its_row(tmp_path):
         "104S:v_elastic,1.5,0.95,0.8,99,,,\nall (99 runs),2.79,0.928,0.9,1188,,,\n"
         ",,0.9,,,104S+105S+106S,12,99\n")
     out = tmp_path / "evidence.csv"
-    done = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"johnson-cook={jc}",
-                           "--out", str(out)], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    code, err = compare_models(capsys, "--model", f"johnson-cook={jc}", "--out", out)
+    assert code == 0, err
     row = pd.read_csv(out).iloc[0]
     assert row["heldout_rmse_m_s"] == 2.79 and row["heldout_coverage"] == 0.928
     (jc / "report" / "emulator_heldout.csv").write_text("feature,rmse_m_s,coverage\n104S:v_elastic,1.5,0.95\n")
-    bad = subprocess.run([sys.executable, "-m", "shockcal", "compare-models", "--model", f"johnson-cook={jc}",
-                          "--out", str(out)], capture_output=True, text=True)
-    assert bad.returncode != 0 and len(bad.stderr.strip().splitlines()) == 1
-    assert "emulator_heldout.csv: no 'all (N runs)' row" in bad.stderr
+    with caplog.at_level("INFO"):                      # the one line is all it prints: no log line either
+        code, err = compare_models(capsys, "--model", f"johnson-cook={jc}", "--out", out)
+    assert code != 0 and len(err.strip().splitlines()) == 1 and not caplog.records
+    assert "emulator_heldout.csv: no 'all (N runs)' row" in err

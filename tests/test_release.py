@@ -81,24 +81,24 @@ def _predictive_study(root, shots, releases_us):
                     root / "predict" / "features" / f"{shot}.parquet")
 
 
-def test_model_predictions_command(tmp_path):
+def test_model_predictions_command(tmp_path, monkeypatch, capsys):
     """`shockcal model-predictions` on the paper's config (its three records) and two laws' synthetic runs: the
     table's predicted medians are the runs' known releases, shift_us their difference from the record's, and
-    one figure page per law; a law without predictive runs is one line naming the file."""
-    import subprocess
-    import sys
-
+    one figure page per law; a law without predictive runs is one line naming the file. The command runs in
+    this process (`python -m shockcal` costs seconds of imports), from the repository like the Makefile's."""
+    from shockcal.cli import main
     from shockcal.velocimetry.records import read_record
+
+    monkeypatch.chdir(REPO)
 
     # the records' plastic plateaus as the extractor read them (results/quick/features/observed.parquet, 2026-11-26)
     shots = {"104S": (1.5667, 199.383), "105S": (2.6065, 358.816), "106S": (4.1035, 479.652)}
     _predictive_study(tmp_path / "jc", shots, [1.5, 1.6, 1.7])
     _predictive_study(tmp_path / "sg", shots, [1.7, 1.8, 1.9])
     out = tmp_path / "models" / "release.csv"
-    done = subprocess.run([sys.executable, "-m", "shockcal", "model-predictions", "--config", "config/config.yaml",
-                           "--model", f"jc={tmp_path / 'jc'}", "--model", f"sg={tmp_path / 'sg'}", "--out", str(out),
-                           "--figures-dir", str(tmp_path / "models" / "figures")], capture_output=True, text=True, cwd=REPO)
-    assert done.returncode == 0, done.stderr
+    code = main(["model-predictions", "--config", "config/config.yaml", "--model", f"jc={tmp_path / 'jc'}", "--model",
+                 f"sg={tmp_path / 'sg'}", "--out", str(out), "--figures-dir", str(tmp_path / "models" / "figures")])
+    assert code == 0, capsys.readouterr().err
     table = pd.read_csv(out)
     assert list(table.columns) == RELEASE_COLUMNS and len(table) == 6
     row = table.set_index(["model", "shot"]).loc[("steinberg-guinan", "104S")]
@@ -109,7 +109,9 @@ def test_model_predictions_command(tmp_path):
     assert row["shift_us"] == pytest.approx(row["release_predicted_median_us"] - row["release_record_us"])
     for law in ("johnson-cook", "steinberg-guinan"):
         assert (tmp_path / "models" / "figures" / f"predictive_{law}.png").is_file()
-    missing = subprocess.run([sys.executable, "-m", "shockcal", "model-predictions", "--config", "config/config.yaml",
-                              "--model", f"ptw={tmp_path / 'nowhere'}", "--out", str(out)], capture_output=True, text=True, cwd=REPO)
-    assert missing.returncode != 0 and "Traceback" not in missing.stderr
-    assert "--model ptw:" in missing.stderr and "observed.parquet does not exist" in missing.stderr
+    capsys.readouterr()
+    code = main(["model-predictions", "--config", "config/config.yaml", "--model", f"ptw={tmp_path / 'nowhere'}", "--out",
+                 str(out)])
+    err = capsys.readouterr().err
+    assert code != 0 and "Traceback" not in err
+    assert "--model ptw:" in err and "observed.parquet does not exist" in err

@@ -15,7 +15,9 @@ def _box_transform(lower, upper):
     return lambda u: lower + u * (upper - lower)
 
 
-@pytest.mark.parametrize("cube_power", [None, [2.0, 1.0, 3.0]])
+# without powers in `make test-slow` (15-30 s): the fast suite keeps the run with powers (the same nautilus run
+# with the warp on top) and the unwarped path's exact posterior through tests/test_calibration.py's linear Gaussian
+@pytest.mark.parametrize("cube_power", [pytest.param(None, marks=pytest.mark.slow), [2.0, 1.0, 3.0]])
 def test_linear_gaussian_posterior_mean_covariance_and_evidence(cube_power):
     # y = X theta + e, e ~ N(0, s^2 I), flat prior on a box far wider than the posterior:
     # posterior N((X'X)^-1 X'y, s^2 (X'X)^-1), evidence = Gaussian integral / box volume.
@@ -48,6 +50,7 @@ def test_linear_gaussian_posterior_mean_covariance_and_evidence(cube_power):
     assert draws.n_likelihood > 2000
 
 
+@pytest.mark.slow   # 8-15 s; the fast suite's two modes: tests/test_calibration.py's (the same sampler, through Problem)
 def test_two_modes_found_in_the_right_proportion():
     # Mixture 0.3 N(-3, 0.5) + 0.7 N(3, 0.5) in x1, x2 ~ N(0, 1): the barrier is ~18 nats deep.
     def log_likelihood(theta):
@@ -72,6 +75,8 @@ def test_a_run_short_of_its_target_at_the_evaluation_limit_is_an_error():
                       max_evaluations=1000)
 
 
+# 9-13 s; the fast suite's same-seed runs: tests/test_progress.py (points and weights), tests/test_calibration.py
+@pytest.mark.slow   # (the resampled draws)
 def test_same_seed_gives_identical_draws():
     def log_likelihood(theta):
         return -0.5 * np.sum((theta - 0.3) ** 2, axis=1) / 0.01

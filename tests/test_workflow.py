@@ -152,20 +152,30 @@ def test_nothing_to_redo(study):
     assert pending_jobs(study[1]) == {}
 
 
-def test_the_settings_of_the_last_run_have_a_stable_path(study, tmp_path):
+@pytest.fixture(scope="module")
+def sampler_change(quick_study, tmp_path_factory):
+    """One dry run (each costs seconds of snakemake's start) with another sampler setting, read by the two tests
+    below: where the effective settings' link pointed before it, and the jobs it would run."""
+    results, config = quick_study
+    pointed = (results / "config" / "effective.yaml").resolve()
+    return pointed, pending_jobs(config, overlay(tmp_path_factory.mktemp("sampler") / "sampler.yaml",
+                                                 calibration={"n_eff": 600}))
+
+
+def test_the_settings_of_the_last_run_have_a_stable_path(study, sampler_change):
     """{results}/config/effective.yaml points at the content-named config the run's jobs read; a dry run with
     other settings writes its own content-named file and leaves the link (and the running jobs' file) alone."""
     results, config = study
     link = results / "config" / "effective.yaml"
     assert link.is_symlink() and re.fullmatch(r"effective-[0-9a-f]{12}\.yaml", os.readlink(link)), os.readlink(link)
-    pointed = link.resolve()
+    pointed, jobs = sampler_change
     assert load_config(link)["design"]["n_runs"] == 40 and load_config(link)["study"]["results_dir"] == str(results)
-    assert pending_jobs(config, overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
+    assert jobs
     assert link.resolve() == pointed and len(list(link.parent.glob("effective-*.yaml"))) >= 2
 
 
-def test_sampler_setting_reruns_no_simulation(study, tmp_path):
-    jobs = pending_jobs(study[1], overlay(tmp_path / "sampler.yaml", calibration={"n_eff": 600}))
+def test_sampler_setting_reruns_no_simulation(sampler_change):
+    _, jobs = sampler_change
     assert jobs.get("calibrate") == 4
     assert not {"design", "simulate", "features_chunk", "features", "emulator"} & set(jobs), jobs
 
