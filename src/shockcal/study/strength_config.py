@@ -18,7 +18,7 @@ import numpy as np
 
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import JOHNSON_COOK_INPUTS
-from shockcal.hydro.laws import flow_stress_curve, get_law, law_values
+from shockcal.hydro.laws import flow_stress_at_states, get_law, law_values
 from shockcal.hydro.laws.boxes import load_boxes
 
 DEFAULT_MODEL = "johnson-cook"
@@ -154,8 +154,7 @@ def check_corners(law, box: dict, constants: dict, source: str) -> None:
         values = {**defaults, **dict(zip(names, corner))}
         where = ", ".join(f"{n}={v:g}" for n, v in zip(names, corner))
         try:
-            stresses = [flow_stress_curve(law, values, [eps], rate, T, P, eta)[0]
-                        for eps, rate, T, P, eta in CORNER_STATES]
+            stresses = flow_stress_at_states(law, values, CORNER_STATES)
         except InputError as exc:
             raise ConfigError(f"{source}: strength: the box's corner {where} breaks the law ({exc}); the law's "
                               "constraints are linear, so boxes that meet them at every corner meet them inside") from None

@@ -18,6 +18,7 @@ aluminium with sources in config/models.yaml (`boxes.py`). The solver calls them
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
@@ -32,8 +33,8 @@ if TYPE_CHECKING:
 
 MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
 
-__all__ = ["LAWS", "Law", "Param", "check_given", "code_parameters", "flow_stress_curve", "get_law", "law_values",
-           "melt_temperature_K", "shear_modulus_gpa", "yield_stress_MPa"]
+__all__ = ["LAWS", "Law", "Param", "check_given", "code_parameters", "flow_stress_at_states", "flow_stress_curve",
+           "get_law", "law_values", "melt_temperature_K", "shear_modulus_gpa", "yield_stress_MPa"]
 
 
 def get_law(name: str) -> Law:
@@ -75,7 +76,7 @@ def check_given(law: Law, values: Mapping) -> None:
     """Check parameter values before the material's constants are filled in (`law_values`): InputError naming
     an unknown parameter, a non-finite value, or a missing one that neither a default nor the material gives."""
     _names_known(law, values)
-    bad = [k for k, v in values.items() if not np.all(np.isfinite(v))]
+    bad = [k for k, v in values.items() if not _finite(v)]
     if bad:
         raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
     missing = [p.name for p in law.params if p.name not in values and p.default is None and p.material is None]
@@ -87,7 +88,7 @@ def user_values(law: Law, values: Mapping[str, float]) -> dict[str, float]:
     """The user's values (the material's constants filled in, `law_values`) completed with the declared
     defaults; InputError naming an unknown or missing parameter, a non-finite value or a violated constraint."""
     merged = _completed(law, values)
-    bad = [k for k, v in merged.items() if not np.isfinite(v)]
+    bad = [k for k, v in merged.items() if not _finite(v)]
     if bad:
         raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
     for text, holds in law.constraints:
@@ -107,8 +108,14 @@ def _completed(law: Law, values: Mapping):
     return merged
 
 
+def _finite(value) -> bool:
+    """Whether a value (a number or an array of them) is finite throughout."""
+    return math.isfinite(value) if isinstance(value, float | int) else bool(np.all(np.isfinite(value)))
+
+
 def _names_known(law: Law, values: Mapping) -> None:
-    unknown = [k for k in values if k not in law.names()]
+    known = set(law.names())
+    unknown = [k for k in values if k not in known]
     if unknown:
         raise InputError(f"{law.name}: unknown parameter {', '.join(unknown)} (parameters: {', '.join(law.names())})")
 
@@ -128,11 +135,18 @@ def flow_stress_curve(law: Law, values: Mapping[str, float], plastic_strains, st
     """Flow stress (MPa) at each equivalent plastic strain, at a constant equivalent strain rate (1/s),
     temperature (K), pressure (GPa) and density ratio rho/rho0; the material constants not in `values` from
     `material` (`law_values`)."""
+    return flow_stress_at_states(law, values, [(e, strain_rate_per_s, temperature_K, pressure_GPa, density_ratio)
+                                               for e in np.asarray(plastic_strains, dtype=float)], material)
+
+
+def flow_stress_at_states(law: Law, values: Mapping[str, float], states,
+                          material: MaterialProperties | None = None) -> np.ndarray:
+    """Flow stress (MPa) of one parameter set (checked once) at each state (equivalent plastic strain,
+    equivalent strain rate 1/s, temperature K, pressure GPa, density ratio rho/rho0); the material constants not
+    in `values` from `material` (`law_values`)."""
     params = code_parameters(law, values, material)
-    rate = strain_rate_per_s * PER_S_TO_PER_US
-    pressure = pressure_GPa / MBAR_TO_GPA
-    return np.array([law.flow_stress(params, float(e), rate, float(temperature_K), pressure, float(density_ratio))
-                     for e in np.asarray(plastic_strains, dtype=float)]) * MBAR_TO_MPA
+    return np.array([law.flow_stress(params, float(eps), rate_per_s * PER_S_TO_PER_US, float(T), P_GPa / MBAR_TO_GPA,
+                                     float(eta)) for eps, rate_per_s, T, P_GPa, eta in states]) * MBAR_TO_MPA
 
 
 def yield_stress_MPa(law: Law, values: Mapping[str, np.ndarray], strain_rate_per_s: float,
