@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import copy
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -95,12 +93,16 @@ def test_a_new_shot_gets_an_emulator_block_of_its_own_on_its_own_runs(paper_conf
     assert "V4" in emulator.blocks[1].input_map.design_inputs() and "V3" not in emulator.blocks[1].input_map.design_inputs()
 
 
-def test_the_new_shot_design_command_refuses_a_base_shot_in_one_line(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "shockcal", "new-shot-design", "--config", "config/config.yaml",
-                           "--shot", "104S", "--posterior", "p.parquet", "--runs", "r.parquet",
-                           "--out", str(tmp_path / "d.parquet")], capture_output=True, text=True, cwd=REPO)
-    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
-    assert "--shot: 104S is not a new shot" in done.stderr
+def test_the_new_shot_design_command_refuses_a_base_shot_in_one_line(tmp_path, monkeypatch, capsys):
+    """The command runs in this process (`python -m shockcal` costs seconds of imports), from the repository."""
+    from shockcal.cli import main
+
+    monkeypatch.chdir(REPO)
+    code = main(["new-shot-design", "--config", "config/config.yaml", "--shot", "104S", "--posterior", "p.parquet",
+                 "--runs", "r.parquet", "--out", str(tmp_path / "d.parquet")])
+    stderr = capsys.readouterr().err
+    assert code == 2 and len(stderr.strip().splitlines()) == 1, stderr
+    assert "--shot: 104S is not a new shot" in stderr
 
 
 def test_a_new_shot_with_one_run_is_refused_naming_the_key(paper_config):

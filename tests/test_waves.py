@@ -4,8 +4,7 @@ stopping rule on constructed posterior summaries, and a later wave's design (the
 from __future__ import annotations
 
 import copy
-import subprocess
-import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -141,14 +140,17 @@ def test_max_variance_thins_only_where_the_variance_is_largest(paper_config, pos
         wave_design(posterior, bounds, 10, 0, 3, criterion="max_variance")
 
 
-def test_wave_design_command_refuses_the_paper_design_in_one_line(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "shockcal", "wave-design", "--config", "config/config.yaml",
-                           "--wave", "1", "--posterior", "p.parquet", "--previous-design", "d.parquet",
-                           "--runs", "r.parquet", "--out", str(tmp_path / "w.parquet")],
-                          capture_output=True, text=True)
-    assert done.returncode == 2
-    assert len(done.stderr.strip().splitlines()) == 1
-    assert done.stderr.strip().endswith("error: wave-design: design.strategy is 'lhs'; waves need 'waves'")
+def test_wave_design_command_refuses_the_paper_design_in_one_line(tmp_path, monkeypatch, capsys):
+    """The command runs in this process (`python -m shockcal` costs seconds of imports), from the repository."""
+    from shockcal.cli import main
+
+    monkeypatch.chdir(Path(__file__).resolve().parents[1])
+    code = main(["wave-design", "--config", "config/config.yaml", "--wave", "1", "--posterior", "p.parquet",
+                 "--previous-design", "d.parquet", "--runs", "r.parquet", "--out", str(tmp_path / "w.parquet")])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    assert len(stderr.strip().splitlines()) == 1
+    assert stderr.strip().endswith("error: wave-design: design.strategy is 'lhs'; waves need 'waves'")
 
 
 def test_a_stopped_wave_passes_through_simulate_and_features_with_no_runs(paper_config):
