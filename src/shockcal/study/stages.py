@@ -32,9 +32,10 @@ _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "stre
 _MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material.T_melt_K", "material.cv_J_per_kg_K",
              "material.strain_rate_ref_per_s")
 
-# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window)
+# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window;
+# `adapters.candidate`: the study's law and its inputs)
 _CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-              "shots.*.analysis", "inputs", *_MATERIAL)
+              "shots.*.analysis", "inputs", "strength.model?", *_MATERIAL)
 _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
