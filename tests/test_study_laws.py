@@ -123,3 +123,30 @@ def test_every_design_row_of_the_literature_box_runs(paper_config, model):
     for _, row in design.iterrows():
         mapping.parameters(row)
     assert np.isfinite(design.drop(columns="run").to_numpy()).all()
+
+
+def test_every_law_reads_its_study_inputs_from_its_declaration(paper_config):
+    """Johnson-Cook is one registry entry: its study inputs are its declared fields (code-unit columns), the
+    emulator's eps^n and T*^m come from the roles it declares, and a next-shot candidate's box and split check
+    read the study's law (another law's candidate box holds its own inputs; its split check names the roles
+    it lacks)."""
+    from shockcal.campaign.candidates import check_split
+    from shockcal.errors import InputError
+    from shockcal.hydro.laws import get_law
+    from shockcal.study.adapters import candidate, candidate_box, material_properties
+
+    law = get_law("johnson-cook")
+    assert law.calibrated_columns() == ["A", "B", "C", "n", "m"]
+    assert (law.role_column("hardening_exponent"), law.role_column("thermal_exponent")) == ("n", "m")
+    section = paper_config["emulator"]
+    assert emulator_spec(paper_config, ["104S"]).powers == ((section["hardening_strain"], "n"),
+                                                            (section["homologous_temperature"], "m"))
+    name = next(iter(paper_config["next_shot"]["candidates"]))
+    assert list(candidate_box(paper_config, name).bounds)[:5] == ["A", "B", "C", "n", "m"]
+    config = _with_model(paper_config, "zerilli-armstrong")
+    box = candidate_box(config, name)
+    assert list(box.bounds)[:4] == ["C0_MPa", "C2_MPa", "C3_per_K", "C4_per_K"]
+    shot = candidate(config, name)
+    assert shot.mapping().model == "zerilli-armstrong" and shot.mapping().strength_inputs[0] == "C0_MPa"
+    with pytest.raises(InputError, match="zerilli-armstrong declares no yield_stress, rate_coefficient, thermal_exponent"):
+        check_split(study_design(config, n_runs=2)[0], shot, material_properties(config), "here")

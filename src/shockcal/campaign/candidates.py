@@ -27,6 +27,7 @@ from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
+from shockcal.hydro.laws import DEFAULT_MODEL, get_law
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
 
@@ -42,7 +43,8 @@ SPLIT_SHARE = 0.5                 # the share of draws without an elastic-plasti
 class Candidate:
     """A candidate shot: its plates (mm, hot thicknesses when heated), nominal impact velocity (m/s),
     initial temperature (K; None: the material's T_ref_K) and the design inputs whose sum is its
-    reference shot's shear modulus (Mbar)."""
+    reference shot's shear modulus (Mbar); the study's strength law (`model`) and its design columns
+    (`strength_inputs`, `shockcal.hydro.laws.Law.column`), which the posterior's draws give."""
 
     name: str
     flyer_mm: float
@@ -50,10 +52,12 @@ class Candidate:
     velocity_m_s: float
     initial_temperature_K: float | None
     shear_modulus_inputs: tuple[str, ...]
+    model: str = DEFAULT_MODEL
+    strength_inputs: tuple[str, ...] = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
 
     def mapping(self) -> ShotMapping:
         """How the candidate reads its design (`candidate_design`'s velocity and shear-modulus columns)."""
-        return ShotMapping(self.name, VELOCITY, (SHEAR_MODULUS,))
+        return ShotMapping(self.name, VELOCITY, (SHEAR_MODULUS,), self.model, self.strength_inputs)
 
 
 def candidate_design(posterior: pd.DataFrame, names: Sequence[str], candidate: Candidate, n: int, seed: int,
@@ -95,19 +99,34 @@ def hel_particle_velocity_m_s(design: pd.DataFrame, candidate: Candidate, materi
     """Particle velocity (m/s) behind each draw's elastic precursor in the candidate's plates: the
     uniaxial-strain yield sigma_HEL = Y0 (K + 4G/3) / (2G), u_e = sigma_HEL / (rho c_L), with the hot
     plates' density and bulk sound speed, G the draw's shear modulus, and Johnson-Cook's initial flow
-    stress Y0 = A (1 + C ln(rate / rate_0)) (1 - T0*^m) at SPLIT_STRAIN_RATE_PER_S (no hardening)."""
+    stress Y0 = A (1 + C ln(rate / rate_0)) (1 - T0*^m) at SPLIT_STRAIN_RATE_PER_S (no hardening), its columns
+    read by the roles the candidate's law declares (`Law.role_column`: yield_stress, rate_coefficient,
+    thermal_exponent); InputError for a law that declares them not."""
+    yield_stress, rate_coefficient, thermal_exponent = _role_columns(
+        candidate.model, ("yield_stress", "rate_coefficient", "thermal_exponent"))
     rho = material.initial_density_g_cc(candidate.initial_temperature_K)
     c_bulk = material.bulk_sound_speed_m_s(candidate.initial_temperature_K) / CM_US_TO_M_S   # cm/us
     g = design[SHEAR_MODULUS].to_numpy(float)
     c_l = np.sqrt(c_bulk**2 + 4.0 * g / (3.0 * rho))
     t0 = material.T_ref_K if candidate.initial_temperature_K is None else candidate.initial_temperature_K
     t_star = max(0.0, (t0 - material.T_ref_K) / (material.T_melt_K - material.T_ref_K))
-    thermal = 1.0 - t_star ** design["m"].to_numpy(float) if t_star > 0 else 1.0
-    rate = 1.0 + design["C"].to_numpy(float) * math.log(SPLIT_STRAIN_RATE_PER_S * PER_S_TO_PER_US
-                                                        / material.rate_ref_per_us())
-    y0 = design["A"].to_numpy(float) * rate * thermal
+    thermal = 1.0 - t_star ** design[thermal_exponent].to_numpy(float) if t_star > 0 else 1.0
+    rate = 1.0 + design[rate_coefficient].to_numpy(float) * math.log(SPLIT_STRAIN_RATE_PER_S * PER_S_TO_PER_US
+                                                                   / material.rate_ref_per_us())
+    y0 = design[yield_stress].to_numpy(float) * rate * thermal
     sigma_hel = y0 * (rho * c_bulk**2 + 4.0 * g / 3.0) / (2.0 * g)
     return sigma_hel / (rho * c_l) * CM_US_TO_M_S
+
+
+def _role_columns(model: str, roles: Sequence[str]) -> list[str]:
+    """The design columns of `roles` in law `model` (`Law.role_column`); InputError naming a role it lacks."""
+    law = get_law(model)
+    columns = [law.role_column(role) for role in roles]
+    missing = [role for role, column in zip(roles, columns, strict=True) if column is None]
+    if missing:
+        raise InputError(f"{law.name}: the elastic-precursor check reads a law's {', '.join(roles)}; "
+                         f"{law.name} declares no {', '.join(missing)}")
+    return columns
 
 
 def check_split(design: pd.DataFrame, candidate: Candidate, material: MaterialProperties, where: str) -> None:

@@ -18,12 +18,15 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError, number, shown
-from shockcal.hydro import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters
+from shockcal.hydro import LawShotParameters, ShotParameters
+from shockcal.hydro.laws import DEFAULT_MODEL, get_law
 from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.design.tables")
+# the columns no design may make negative: the default law's (ShotParameters' rule), whatever the study's law
+NONNEGATIVE_COLUMNS = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
 
 
 @dataclass(frozen=True)
@@ -122,7 +125,7 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
             row = design.loc[bad, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({shown(design.loc[bad, name].iloc[0])})")
         design[name] = values.astype(float)
-        if name in JOHNSON_COOK_INPUTS and (values < 0).any():
+        if name in NONNEGATIVE_COLUMNS and (values < 0).any():
             row = design.loc[values < 0, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} = {number(values[values < 0].iloc[0])} is negative")
     design["run"] = design["run"].astype(np.int64)
@@ -154,28 +157,29 @@ def check_design_box(design: pd.DataFrame, box: InputBox, columns: list[str], so
 class ShotMapping:
     """How one shot reads a design row (SPEC section 3): the input that is its impact velocity (cm/us),
     the inputs whose sum is its shear modulus (Mbar; none for a law with its own G law), and the strength
-    law's inputs every shot shares: Johnson-Cook's A, B, C, n, m in Table IV units, or another law's
-    declared parameters in the units their names carry (`shockcal.hydro.laws`)."""
+    law's inputs every shot shares, its design columns (`shockcal.hydro.laws.Law.column`): Johnson-Cook's
+    A, B, C, n, m in code units (Mbar), another law's declared parameters in the units their names carry.
+    The default law and its columns are the registry's (`DEFAULT_MODEL`)."""
 
     shot: str
     velocity_input: str
     shear_modulus_inputs: tuple[str, ...]
-    model: str = "johnson-cook"
-    strength_inputs: tuple[str, ...] = JOHNSON_COOK_INPUTS
+    model: str = DEFAULT_MODEL
+    strength_inputs: tuple[str, ...] = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
 
     def inputs(self) -> list[str]:
         """The design columns the shot depends on: the law's inputs, its velocity, its shear-modulus terms."""
         return [*self.strength_inputs, self.velocity_input, *self.shear_modulus_inputs]
 
     def parameters(self, row) -> ShotParameters | LawShotParameters:
-        """One design row (a mapping of input name to value) as this shot's hydrocode inputs. Johnson-Cook's
-        Table IV values reach the kernel unconverted (`ShotParameters.from_table_iv`); another law's go
+        """One design row (a mapping of input name to value) as this shot's hydrocode inputs. A law with
+        code-unit columns (Johnson-Cook's Table IV values) reaches the kernel unconverted (`ShotParameters.from_table_iv`); another law's go
         through `LawShotParameters` (its material constants and constraints are checked by `run_shot`, with
         the run's material)."""
         velocity = float(row[self.velocity_input])
         shear = float(sum(row[k] for k in self.shear_modulus_inputs)) if self.shear_modulus_inputs else None
-        if self.model == "johnson-cook":
-            return ShotParameters.from_table_iv(*(float(row[k]) for k in JOHNSON_COOK_INPUTS),
+        if get_law(self.model).code_unit_columns:     # Johnson-Cook: its code-unit door
+            return ShotParameters.from_table_iv(*(float(row[k]) for k in self.strength_inputs),
                                                 velocity_cm_us=velocity, shear_modulus_Mbar=shear)
         return LawShotParameters(self.model, {k: float(row[k]) for k in self.strength_inputs},
                                  velocity * CM_US_TO_M_S, None if shear is None else shear * MBAR_TO_GPA)

@@ -15,8 +15,9 @@ import pandas as pd
 from shockcal.design.tables import ShotMapping
 from shockcal.emulator.yield_input import YieldInput
 
-# extra emulator inputs base^column: config emulator key of the base, design column
-POWER_INPUTS = [("hardening_strain", "n"), ("homologous_temperature", "m")]
+# extra emulator inputs base^column: config emulator key of the base, the column's role in the strength law
+# (`shockcal.hydro.laws.Law.role_column`: Johnson-Cook's n and m)
+POWER_INPUTS = [("hardening_strain", "hardening_exponent"), ("homologous_temperature", "thermal_exponent")]
 
 
 @dataclass

@@ -8,9 +8,9 @@ the study (config, design, features). See docs/hydro.md.
 """
 
 from shockcal.hydro.material_library import load_material, material_properties
-from shockcal.hydro.parameters import JOHNSON_COOK_INPUTS, LawShotParameters, ShotParameters, TableIV
+from shockcal.hydro.parameters import LawShotParameters, ShotParameters, TableIV
 from shockcal.hydro.settings import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.shot import RunResult, run_shot
 
-__all__ = ["JOHNSON_COOK_INPUTS", "Geometry", "HydroSettings", "LawShotParameters", "MaterialProperties",
+__all__ = ["Geometry", "HydroSettings", "LawShotParameters", "MaterialProperties",
            "RunResult", "ShotParameters", "TableIV", "load_material", "material_properties", "run_shot"]

@@ -34,10 +34,6 @@ from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA, MBAR_TO_MPA
 if TYPE_CHECKING:
     from shockcal.hydro.settings import MaterialProperties
 
-# The Johnson-Cook inputs every shot shares (SPEC section 3), as the design tables name them.
-JOHNSON_COOK_INPUTS = ("A", "B", "C", "n", "m")
-
-
 class TableIV(NamedTuple):
     """One run's inputs in the paper's Table IV units, which are the hydrocode's (Mbar, cm/us)."""
 

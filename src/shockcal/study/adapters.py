@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING
 
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
-from shockcal.hydro.laws import get_law
 from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.seeds import stream_seed
 from shockcal.study.config import (
@@ -29,7 +28,7 @@ from shockcal.study.config import (
     velocity_box_m_s,
     wave_sizes,
 )
-from shockcal.study.strength_config import DEFAULT_MODEL, material_constants, strength_model, strength_parameters
+from shockcal.study.strength_config import material_constants, strength_law, strength_parameters
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -52,13 +51,9 @@ def shot_mapping(config: dict, shot: str) -> ShotMapping:
     """How `shot` reads a design row (`shots.<shot>`, `strength.model` and the law's boxed parameters in
     `inputs`; a ConfigError names an unknown shot)."""
     spec = shot_config(config, shot)
-    model = strength_model(config)
-    if model == DEFAULT_MODEL:
-        return ShotMapping(shot, spec["velocity_input"], tuple(spec["shear_modulus_inputs"]))
-    law = get_law(model)
+    law = strength_law(config)
     modulus = () if law.shear_modulus is not None else tuple(spec["shear_modulus_inputs"])
-    return ShotMapping(shot, spec["velocity_input"], modulus, law.name,
-                       tuple(name for name in config["inputs"] if name in law.names()))
+    return ShotMapping(shot, spec["velocity_input"], modulus, law.name, tuple(strength_parameters(config)))
 
 
 def material_properties(config: dict) -> MaterialProperties:
@@ -103,23 +98,24 @@ def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
 
 
 def candidate(config: dict, name: str) -> Candidate:
-    """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs."""
+    """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs and the study's law and
+    its inputs."""
     from shockcal.campaign.candidates import Candidate
 
     spec = candidate_config(config, name)
     temperature = spec["initial_temperature_K"]
     return Candidate(name, float(spec["flyer_mm"]), float(spec["target_mm"]), float(spec["velocity_m_s"]),
-                     None if temperature is None else float(temperature), tuple(spec["shear_modulus_inputs"]))
+                     None if temperature is None else float(temperature), tuple(spec["shear_modulus_inputs"]),
+                     strength_law(config).name, tuple(strength_parameters(config)))
 
 
 def candidate_box(config: dict, name: str) -> InputBox:
-    """The box a candidate's design lies in: the prior box of the Johnson-Cook inputs, and the
+    """The box a candidate's design lies in: the prior box of the law's inputs (`strength_parameters`), and the
     candidate's velocity (cm/us, within the velocity error's range) and shear modulus (Mbar, the
     reference shot's box plus the range of its thermal increment, `shear_modulus_increment_box_Mbar`:
     it holds both the ranking's draws, G_ref (1 + s dT), and the next-shot check's training runs, whose
     increment is an input of its own)."""
     from shockcal.campaign.candidates import SHEAR_MODULUS, VELOCITY
-    from shockcal.hydro import JOHNSON_COOK_INPUTS
     from shockcal.study.config import shear_modulus_box_Mbar, shear_modulus_increment_box_Mbar
     from shockcal.units import CM_US_TO_M_S
 
@@ -129,10 +125,11 @@ def candidate_box(config: dict, name: str) -> InputBox:
     velocity = shot.velocity_m_s / CM_US_TO_M_S
     g_box = shear_modulus_box_Mbar(config, config["next_shot"]["candidates"][name]["shot"]) or (0.0, float("inf"))
     increment = shear_modulus_increment_box_Mbar(config, name) or (0.0, 0.0)
-    bounds = {**{k: v for k, v in prior_bounds(config).items() if k in JOHNSON_COOK_INPUTS},
+    strength = strength_parameters(config)
+    bounds = {**{k: v for k, v in prior_bounds(config).items() if k in strength},
               VELOCITY: (velocity * (1 - spread), velocity * (1 + spread)),
               SHEAR_MODULUS: (g_box[0] + increment[0], g_box[1] + increment[1])}
-    units = {**{k: config["inputs"][k]["unit"] for k in JOHNSON_COOK_INPUTS}, VELOCITY: "cm/us", SHEAR_MODULUS: "Mbar"}
+    units = {**{k: config["inputs"][k]["unit"] for k in strength}, VELOCITY: "cm/us", SHEAR_MODULUS: "Mbar"}
     return InputBox(bounds, units, {VELOCITY: name}, config["checks"]["design_box"])
 
 
@@ -147,16 +144,19 @@ def emulator_settings(config: dict) -> EmulatorSettings:
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
     """`emulator`, `inputs`, the shots' mappings and study.seed, for the emulator of `shots` (the power
-    inputs eps^n and T*^m for Johnson-Cook only; the yield input for the laws of `emulator.yield_input`,
+    inputs eps^n and T*^m for a law whose declaration gives both roles, `Law.role_column`: Johnson-Cook's n
+    and m; the yield input for the laws of `emulator.yield_input`,
     at material.T_ref_K with the law's material constants)."""
     from shockcal.emulator.input_map import POWER_INPUTS
     from shockcal.emulator.study_emulator import EmulatorSpec
     from shockcal.emulator.yield_input import YieldInput
 
     section = config["emulator"]
-    model = strength_model(config)
-    jc = model == DEFAULT_MODEL        # eps^n and T*^m are Johnson-Cook's factors
-    powers = tuple((section[key], column) for key, column in POWER_INPUTS if section[key] and jc)
+    law = strength_law(config)
+    model = law.name
+    exponents = [(key, law.role_column(role)) for key, role in POWER_INPUTS]
+    powers = tuple((section[key], column) for key, column in exponents
+                   if section[key] and all(column for _, column in exponents))
     mappings = {s: shot_mapping(config, s) for s in shots}
     yield_section = section.get("yield_input")    # left out of the stage's slice for a law it does not list
     yield_input = None

@@ -10,11 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from shockcal.errors import ConfigError, InputError, number
-from shockcal.hydro import JOHNSON_COOK_INPUTS, rules
+from shockcal.hydro import rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
-from shockcal.study.strength_config import DEFAULT_MODEL, next_shot_targets, strength_model
+from shockcal.study.strength_config import next_shot_targets, strength_law
 from shockcal.units import MM_TO_CM
 
 
@@ -25,12 +25,15 @@ def check_semantics(config: dict, source: str = "config") -> None:
     for name, box in inputs.items():
         if not box["min"] < box["max"]:
             raise ConfigError(f"{source}: inputs.{name}: min ({box['min']}) must be below max ({box['max']})")
-    for name in JOHNSON_COOK_INPUTS if strength_model(config) == DEFAULT_MODEL else ():
+    law = strength_law(config)
+    required = tuple(law.calibrated_columns()) if law.code_unit_columns else ()    # a box given in `inputs`
+    who = law.title.split(" (")[0]
+    for name in required:
         if name not in inputs:
-            raise ConfigError(f"{source}: inputs.{name}: missing; the Johnson-Cook inputs {JOHNSON_COOK_INPUTS} are required")
+            raise ConfigError(f"{source}: inputs.{name}: missing; the {who} inputs {required} are required")
         problem = rules.problem(inputs[name]["min"], "nonnegative")       # ShotParameters' rule
         if problem:
-            raise ConfigError(f"{source}: inputs.{name}.min: {problem}; Johnson-Cook parameters cannot be negative")
+            raise ConfigError(f"{source}: inputs.{name}.min: {problem}; {who} parameters cannot be negative")
     for shot, spec in config["shots"].items():
         mapped = [("velocity_input", spec["velocity_input"])]
         mapped += [(f"shear_modulus_inputs[{i}]", name) for i, name in enumerate(spec["shear_modulus_inputs"])
@@ -104,9 +107,7 @@ def check_waves(config: dict, source: str = "config") -> None:
 
 def _law_has_modulus(config: dict) -> bool:
     """Whether the study's law computes G itself (then the shots' shear-modulus inputs are not read)."""
-    from shockcal.hydro.laws import get_law
-
-    return get_law(strength_model(config)).shear_modulus is not None
+    return strength_law(config).shear_modulus is not None
 
 
 # the plastic rise needs this long inside the window after the plastic wave arrives (the paper's shots rise

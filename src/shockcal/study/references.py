@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws import get_law
-from shockcal.study.strength_config import DEFAULT_MODEL, strength_model
+from shockcal.study.strength_config import section_model, strength_model
 from shockcal.units import DIMENSIONLESS, unit_factor
 
 
@@ -39,17 +39,11 @@ def check_reference_sets(config: dict, source: str) -> None:
         if given["label"] in labels:
             raise ConfigError(f"{where}.label: '{given['label']}' is the label of an earlier set")
         labels.add(given["label"])
-        law = get_law(given.get("model", DEFAULT_MODEL))
+        law = get_law(section_model(given))
         for name in given["values"]:
             if name not in law.names():
                 raise ConfigError(f"{where}.values.{name}: not a parameter of {law.name} "
                                   f"(parameters: {', '.join(law.names())})")
-
-
-def _input_name(param, model: str) -> str:
-    """The study input that holds a law parameter: Johnson-Cook's inputs keep the paper's names (A, B, C, n,
-    m: the declaration's `field`), another law's are named as declared (Y0_GPa)."""
-    return param.field if model == DEFAULT_MODEL else param.name
 
 
 def drawn_sets(config: dict) -> list[ReferenceSet]:
@@ -59,13 +53,13 @@ def drawn_sets(config: dict) -> list[ReferenceSet]:
     law = get_law(model)
     sets = []
     for given in _given(config):
-        if given.get("model", DEFAULT_MODEL) != model:
+        if section_model(given) != model:
             continue
         values = {}
         for name, value in given["values"].items():
             param = law.param(name)
-            if _input_name(param, model) in config["inputs"]:
-                values[_input_name(param, model)] = (float(value), param.unit)
+            if law.column(param) in config["inputs"]:      # the study input that holds it (`Law.column`)
+                values[law.column(param)] = (float(value), param.unit)
         sets.append(ReferenceSet(given["label"], given.get("citation", ""), values))
     return sets
 

@@ -21,7 +21,7 @@ from collections.abc import Iterable, Iterator
 
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
-from shockcal.study.strength_config import DEFAULT_MODEL, strength_model
+from shockcal.study.strength_config import strength_law, strength_model
 from shockcal.study.validate import load_config
 
 _SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
@@ -32,9 +32,10 @@ _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "stre
 _MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material.T_melt_K", "material.cv_J_per_kg_K",
              "material.strain_rate_ref_per_s")
 
-# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window)
+# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window;
+# `adapters.candidate`: the study's law and its inputs)
 _CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-              "shots.*.analysis", "inputs", *_MATERIAL)
+              "shots.*.analysis", "inputs", "strength.model?", *_MATERIAL)
 _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
@@ -123,15 +124,13 @@ def _law_material_keys(config: dict, stages: list[str]) -> list[str]:
     for the constants it does not calibrate (`shockcal.study.strength_config.material_constants`): in the slice
     of the simulate stage, and of the emulate stage for a law with the yield input; none for another law, so
     that a material key only PTW or Steinberg-Guinan reads reruns no other law's jobs."""
-    model = strength_model(config)
-    if model == DEFAULT_MODEL:
+    law = strength_law(config)
+    if law.code_unit_columns:     # Johnson-Cook: its constants are in _MATERIAL already
         return []
-    yield_input = model in config["emulator"]["yield_input"]["models"]
+    yield_input = law.name in config["emulator"]["yield_input"]["models"]
     if "simulate" not in stages and not ("emulate" in stages and yield_input):
         return []
-    from shockcal.hydro.laws import get_law
-
-    return [f"material.{p.material}" for p in get_law(model).params
+    return [f"material.{p.material}" for p in law.params
             if p.material is not None and p.name not in config["inputs"]]
 
 

@@ -1,6 +1,7 @@
 """The study's strength law (config `strength`): the prior box it calibrates, checked before any run.
 
-With `strength.model` other than johnson-cook, `apply_strength_model` rewrites the validated config's
+With a `strength.model` whose box is not `inputs` itself (every law but Johnson-Cook, whose
+declaration has `code_unit_columns`), `apply_strength_model` rewrites the validated config's
 `inputs` into the law's box (`strength.inputs`, else `strength.models_file`), each shot's velocity
 input and, for a law without a shear-modulus law, each shot's modulus inputs, so that every stage
 reads its box, names and units from `inputs` as for Johnson-Cook; `strength.inputs` then holds the
@@ -17,28 +18,42 @@ from pathlib import Path
 import numpy as np
 
 from shockcal.errors import ConfigError, InputError
-from shockcal.hydro import JOHNSON_COOK_INPUTS
-from shockcal.hydro.laws import flow_stress_at_states, get_law, law_values
+from shockcal.hydro.laws import DEFAULT_MODEL, Law, flow_stress_at_states, get_law, law_values
 from shockcal.hydro.laws.boxes import load_boxes
 
-DEFAULT_MODEL = "johnson-cook"
 # states at which a box's corners must give a finite, non-negative flow stress:
 # (plastic strain, equivalent strain rate 1/s, temperature K, pressure GPa, density ratio)
 CORNER_STATES = ((0.0, 1.0e-3, 298.0, 0.0, 1.0), (0.2, 1.0e6, 298.0, 5.0, 1.06), (0.5, 1.0e7, 600.0, 10.0, 1.1))
 MAX_CORNERS = 2 ** 16
 
 
+def section_model(section: dict | None) -> str:
+    """The law a config section names (`model` of `strength` or of a reference set): DEFAULT_MODEL when it is
+    left out; the one place that says which law that is."""
+    return (section or {}).get("model", DEFAULT_MODEL)
+
+
 def strength_model(config: dict) -> str:
     """The study's law (`strength.model`; johnson-cook when the section is left out)."""
-    return (config.get("strength") or {}).get("model", DEFAULT_MODEL)
+    return section_model(config.get("strength"))
+
+
+def strength_law(config: dict) -> Law:
+    """The study's law's declaration (`shockcal.hydro.laws.get_law`)."""
+    return get_law(strength_model(config))
+
+
+def default_law_columns() -> list[str]:
+    """The inputs a config without `strength` calibrates (the default law's `calibrated_columns`), which a
+    config of another law may still carry from the base config an overlay cannot delete keys of."""
+    return get_law(DEFAULT_MODEL).calibrated_columns()
 
 
 def strength_parameters(config: dict) -> list[str]:
-    """The study's strength-law inputs: Johnson-Cook's A, B, C, n, m, or another law's boxed parameters."""
-    model = strength_model(config)
-    if model == DEFAULT_MODEL:
-        return list(JOHNSON_COOK_INPUTS)
-    return [p.name for p in get_law(model).params if p.name in config["inputs"]]
+    """The study's strength-law inputs: the law's design columns (`Law.column`) that `inputs` boxes, in the
+    law's order (Johnson-Cook's A, B, C, n, m; another law's boxed parameters)."""
+    law = strength_law(config)
+    return [law.column(p) for p in law.params if law.column(p) in config["inputs"]]
 
 
 def next_shot_targets(config: dict) -> list[str]:
@@ -48,17 +63,16 @@ def next_shot_targets(config: dict) -> list[str]:
 
 
 def apply_strength_model(config: dict, source: str) -> None:
-    """For a law other than Johnson-Cook: `inputs` becomes the law's box (declared units) followed by the
+    """For a law without `code_unit_columns` (all but Johnson-Cook): `inputs` becomes the law's box (declared units) followed by the
     shots' velocity inputs and, for a law without a G law, their shear-modulus inputs; `calibration.cube_power`
     drops Johnson-Cook's inputs the law does not have (a Johnson-Cook config's power, kept by an overlay that
     cannot delete it); a name the law has (Steinberg-Guinan's n) keeps its power. ConfigError naming the key:
     a parameter the law does not have, a missing bound, min >= max, an input that is neither the law's nor a
     shot's, a material constant the law needs and `material` does not give, a box corner whose flow stress is
     negative or not finite."""
-    model = strength_model(config)
-    if model == DEFAULT_MODEL:
+    law = strength_law(config)
+    if law.code_unit_columns:      # its box is `inputs` itself
         return
-    law = get_law(model)
     section = config["strength"]
     given = section.get("inputs") or {}
     for name in given:
@@ -87,7 +101,7 @@ def apply_strength_model(config: dict, source: str) -> None:
     section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
     cube = config["calibration"]["cube_power"]
     config["calibration"]["cube_power"] = {k: v for k, v in cube.items()
-                                           if k in config["inputs"] or k not in JOHNSON_COOK_INPUTS}
+                                           if k in config["inputs"] or k not in default_law_columns()}
 
 
 def _calibrated(param) -> bool:
@@ -127,7 +141,7 @@ def _shot_inputs(config: dict, law, given: dict, source: str) -> dict:
     for name, spec in config["inputs"].items():
         if name in kept:
             out[name] = spec
-        elif name in JOHNSON_COOK_INPUTS or name in modulus:
+        elif name in default_law_columns() or name in modulus:
             continue
         elif name in given and (given[name]["min"], given[name]["max"]) == (spec["min"], spec["max"]):
             continue

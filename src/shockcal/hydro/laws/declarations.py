@@ -12,7 +12,7 @@ config/models.yaml (`shockcal.hydro.laws.boxes`).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from shockcal.hydro.laws.johnson_cook import (
     JohnsonCook,
@@ -92,7 +92,11 @@ class Law:
     the cell's G, not recomputed), `flow_stress_floor(law, hard, G, rate, T, eta, flow_floor, floor_hotter,
     floor_T)`, a proven lower bound of the flow stress from `hardening(law, eps_p)`, which the solver caches
     per cell, and from the floor `remember_floor(law, G, eps_p, rate, T, eta, ...)` sets after a full
-    evaluation found the cell elastic."""
+    evaluation found the cell elastic. A study's design columns (`column`): the kernel's fields in code units
+    for a law with `code_unit_columns` (Johnson-Cook, whose box a study gives in `inputs`), else the declared
+    names in user units (a box in `strength.inputs` or config/models.yaml). `roles` names the parameters
+    that study code reads by their part in the law (`role_column`): the emulator's power inputs
+    (eps^n, T*^m) and the next-shot check's initial yield stress."""
 
     name: str
     title: str
@@ -107,12 +111,29 @@ class Law:
     hardening: Callable | None = None
     flow_stress_floor: Callable | None = None
     remember_floor: Callable | None = None
+    code_unit_columns: bool = False
+    roles: Mapping[str, str] = field(default_factory=dict)
 
     def param(self, name: str) -> Param:
         return next(p for p in self.params if p.name == name)
 
     def names(self) -> list[str]:
         return [p.name for p in self.params]
+
+    def column(self, param: Param) -> str:
+        """The design-table column (study input) that holds `param`: its kernel `field`, in code units, for a
+        law with `code_unit_columns` (Johnson-Cook: A, B in Mbar, C, n, m), else its declared `name`."""
+        return param.field if self.code_unit_columns else param.name
+
+    def calibrated_columns(self) -> list[str]:
+        """The columns of the parameters a study must box: neither a declared default nor a material constant."""
+        return [self.column(p) for p in self.params if p.default is None and p.material is None]
+
+    def role_column(self, role: str) -> str | None:
+        """The column of the parameter that plays `role` (`roles`: "hardening_exponent", "rate_coefficient",
+        "thermal_exponent", "yield_stress"), or None when the law has no such parameter."""
+        name = self.roles.get(role)
+        return None if name is None else self.column(self.param(name))
 
 
 JOHNSON_COOK = Law(
@@ -135,6 +156,8 @@ JOHNSON_COOK = Law(
     melt_temperature=lambda law, eta: law.T_melt,
     hardening=johnson_cook_hardening, flow_stress_floor=johnson_cook_flow_stress_floor,
     remember_floor=johnson_cook_remember_floor,
+    code_unit_columns=True,
+    roles={"yield_stress": "A_MPa", "rate_coefficient": "C", "hardening_exponent": "n", "thermal_exponent": "m"},
 )
 
 STEINBERG_GUINAN = Law(
@@ -213,4 +236,5 @@ ZERILLI_ARMSTRONG = Law(
 
 LAWS: dict[str, Law] = {law.name: law for law in (JOHNSON_COOK, STEINBERG_GUINAN, PRESTON_TONKS_WALLACE,
                                                   ZERILLI_ARMSTRONG)}
+DEFAULT_MODEL = JOHNSON_COOK.name    # the law of a study config without `strength.model`, and of `ShotParameters`
 ALIASES = {"jc": "johnson-cook", "sg": "steinberg-guinan", "preston-tonks-wallace": "ptw", "za": "zerilli-armstrong"}
