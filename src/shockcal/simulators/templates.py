@@ -63,7 +63,7 @@ def run_values(mapping: ShotMapping, row: Mapping, geometry: Geometry, material:
               "flyer_mm": geometry.flyer_mm, "target_mm": geometry.target_mm, "end_time_us": geometry.end_us,
               "initial_temperature_K": (material.T_ref_K if geometry.initial_temperature_K is None
                                         else geometry.initial_temperature_K),
-              **asdict(material), **asdict(settings)}
+              **asdict(material), **settings.model_dump()}
     values["velocity_cm_us"] = float(row[mapping.velocity_input])
     if mapping.model == "johnson-cook":
         exact = params.table_iv()
