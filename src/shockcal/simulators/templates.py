@@ -50,8 +50,8 @@ def placeholder_units(mapping: ShotMapping) -> dict[str, str]:
         names.update({name: _unit(name) for name in mapping.strength_inputs})
     if mapping.shear_modulus_inputs:
         names.update(_MODULUS)
-    for settings in (MaterialProperties, HydroSettings):
-        names.update({f.name: _unit(f.name) for f in fields(settings)})
+    names.update({f.name: _unit(f.name) for f in fields(MaterialProperties)})
+    names.update({name: _unit(name) for name in HydroSettings.model_fields})
     return names
 
 
