@@ -141,7 +141,7 @@ def _schema_node(schema: dict, path: str) -> dict:
 
 
 def _field_names(cls) -> list[str]:
-    """The fields of a settings dataclass or settings model (`shockcal.settings_model`)."""
+    """The fields of a settings dataclass or settings model (`shockcal.hydro.settings_model`)."""
     from dataclasses import fields
 
     return list(cls.model_fields) if hasattr(cls, "model_fields") else [f.name for f in fields(cls)]

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
 from shockcal.hydro.rules import check_fields, melting_problem, plate_problem
+from shockcal.hydro.settings_model import SettingsModel, setting
 from shockcal.hydro.state import InitialState, Material, Numerics
-from shockcal.settings_model import SettingsModel, setting
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
 
@@ -129,7 +129,7 @@ class MaterialProperties:
 class HydroSettings(SettingsModel):
     """Mesh, output sampling, artificial viscosity and time stepping: the study config's `hydro` section
     (its other key, `end_time_us`, is the Geometry's end_us). Each field's default, rule and description is
-    here once; the config schema's entries are generated from them (`shockcal.settings_model`) and
+    here once; the config schema's entries are generated from them (`shockcal.hydro.settings_model`) and
     docs/hydro.md measures the defaults. Checked on creation: an InputError naming the field."""
 
     cell_size_um: float = setting(4.0, "Mesh cell size in both plates.", "positive")

@@ -23,7 +23,7 @@ import yaml
 
 from shockcal.errors import ConfigError
 from shockcal.hydro.settings import HydroSettings
-from shockcal.settings_model import schema_properties
+from shockcal.hydro.settings_model import schema_properties
 
 EXTENDS = "extends"
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -32,7 +32,7 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 
 
 # Config sections whose keys are a library settings model's fields: the schema's entries for them are
-# generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest.
+# generated from the model (`shockcal.hydro.settings_model.schema_properties`), the YAML holds only the rest.
 MODEL_SECTIONS = {"hydro": HydroSettings}
 
 

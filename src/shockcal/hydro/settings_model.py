@@ -10,7 +10,7 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from shockcal.errors import InputError
-from shockcal.hydro import rules
+from shockcal.hydro.rules import check_fields
 
 RULE = "x-rule"
 
@@ -37,7 +37,7 @@ class SettingsModel(BaseModel):
 
     @model_validator(mode="after")
     def _check_rules(self):
-        rules.check_fields(self, {name: extra[RULE] for name, extra in _extras(type(self)).items() if RULE in extra})
+        check_fields(self, {name: extra[RULE] for name, extra in _extras(type(self)).items() if RULE in extra})
         return self
 
 
