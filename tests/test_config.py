@@ -11,6 +11,7 @@ import yaml
 
 from shockcal.errors import ConfigError
 from shockcal.study.config import shot_config
+from shockcal.study.config_files import MODEL_SECTIONS
 from shockcal.study.validate import load_config, validate_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -139,10 +140,20 @@ def _schema_node(schema: dict, path: str) -> dict:
     return node
 
 
+def _field_names(cls) -> list[str]:
+    """The fields of a settings dataclass or settings model (`shockcal.hydro.settings_model`)."""
+    from dataclasses import fields
+
+    return list(cls.model_fields) if hasattr(cls, "model_fields") else [f.name for f in fields(cls)]
+
+
 def _library_defaults(cls) -> dict:
-    """{field: default} of a dataclass's fields that have one (a default_factory called)."""
+    """{field: default} of a dataclass's or settings model's fields that have one (a default_factory called)."""
     from dataclasses import MISSING, fields
 
+    if hasattr(cls, "model_fields"):
+        return {name: field.get_default(call_default_factory=True) for name, field in cls.model_fields.items()
+                if not field.is_required()}
     return {f.name: f.default if f.default_factory is MISSING else f.default_factory()
             for f in fields(cls) if f.default is not MISSING or f.default_factory is not MISSING}
 
@@ -152,15 +163,14 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
     """A notebook's `Settings()` and a config that leaves the keys out agree: a library default that differs
     from the schema's fails here, whichever side drifted."""
     import importlib
-    from dataclasses import fields
 
-    from shockcal.study.config_files import SCHEMA_PATH
+    from shockcal.study.config_files import load_schema
 
     module, name = target.split(":")
     cls = getattr(importlib.import_module(module), name)
-    schema = yaml.safe_load(SCHEMA_PATH.read_text())
-    keys = {f.name: f"{section}.{f.name}" for section in reversed(sections) for f in fields(cls)
-            if f.name in _schema_node(schema, section).get("properties", {})} | renamed
+    schema = load_schema()
+    keys = {field: f"{section}.{field}" for section in reversed(sections) for field in _field_names(cls)
+            if field in _schema_node(schema, section).get("properties", {})} | renamed
     config = {field: _schema_node(schema, path) for field, path in keys.items()}
     config_defaults = {field: node["default"] for field, node in config.items() if "default" in node}
     library = _library_defaults(cls)
@@ -172,6 +182,26 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
         section_defaults = {k for section in sections
                             for k, node in _schema_node(schema, section)["properties"].items() if "default" in node}
         assert section_defaults <= set(library) and set(library) <= set(keys)
+
+
+@pytest.mark.parametrize("section", sorted(MODEL_SECTIONS))
+def test_a_settings_models_section_of_the_schema_is_generated_from_it(section):
+    """One definition: each field of the section's model is a schema key with the model's default (unless the
+    section requires the key), description and rule, and the YAML file names none of them."""
+    from shockcal.study.config_files import SCHEMA_PATH, load_schema
+
+    model, node = MODEL_SECTIONS[section], load_schema()["properties"][section]
+    written = yaml.safe_load(SCHEMA_PATH.read_text())["properties"][section]["properties"]
+    assert not set(model.model_fields) & set(written), f"{section}: a field of {model.__name__} also in the YAML"
+    for name, field in model.model_fields.items():
+        key = node["properties"][name]
+        assert key["description"] == field.description and field.description
+        assert key.get("x-rule") == (field.json_schema_extra or {}).get("x-rule")
+        assert key.get("x-unit") == (field.json_schema_extra or {}).get("x-unit")
+        if name in node.get("required", []):
+            assert "default" not in key
+        else:
+            assert key["default"] == field.default
 
 
 @pytest.mark.parametrize("path, value, message", [

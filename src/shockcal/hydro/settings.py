@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
 from shockcal.hydro.rules import check_fields, melting_problem, plate_problem
+from shockcal.hydro.settings_model import SettingsModel, setting
 from shockcal.hydro.state import InitialState, Material, Numerics
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
 
@@ -125,32 +126,22 @@ class MaterialProperties:
         return math.sqrt(c_sq) * CM_US_TO_M_S
 
 
-@dataclass(frozen=True)
-class HydroSettings:
-    """Mesh, output sampling, artificial viscosity and time stepping; the defaults are the study config's
-    (docs/hydro.md measures them). Checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
+class HydroSettings(SettingsModel):
+    """Mesh, output sampling, artificial viscosity and time stepping: the study config's `hydro` section
+    (its other key, `end_time_us`, is the Geometry's end_us). Each field's default, rule and description is
+    here once; the config schema's entries are generated from them (`shockcal.hydro.settings_model`) and
+    docs/hydro.md measures the defaults. Checked on creation: an InputError naming the field."""
 
-    Args:
-        cell_size_um: Lagrangian cell size (um).
-        output_dt_ns: sampling interval of the free-surface velocity history (ns).
-        cfl: Courant number of the time step (signal speed with the viscosity's).
-        dt_initial_us: first time step (us).
-        dt_max_us: largest time step (us).
-        q_linear, q_quadratic: artificial viscosity q = rho (q_quadratic du^2 + q_linear c du) (-).
-    """
-
-    cell_size_um: float = 4.0
-    output_dt_ns: float = 0.5
-    cfl: float = 0.5
-    dt_initial_us: float = 1.0e-7
-    dt_max_us: float = 2.0e-3
-    q_linear: float = 0.1
-    q_quadratic: float = 1.0
-
-    def __post_init__(self):
-        check_fields(self, {"cell_size_um": "positive", "output_dt_ns": "positive", "cfl": "courant",
-                            "dt_initial_us": "positive", "dt_max_us": "positive", "q_linear": "nonnegative",
-                            "q_quadratic": "nonnegative"})
+    cell_size_um: float = setting(4.0, "Mesh cell size in both plates.", "positive")
+    output_dt_ns: float = setting(0.5, "Sampling interval of the free-surface velocity trace written per run.",
+                                  "positive")
+    cfl: float = setting(0.5, "CFL number of the time step, on the longitudinal sound speed with the viscous "
+                              "signal speed.", "courant")
+    dt_initial_us: float = setting(1.0e-7, "First time step; the step then grows by at most 10% a step.", "positive")
+    dt_max_us: float = setting(2.0e-3, "Largest time step.", "positive")
+    q_linear: float = setting(0.1, "Linear artificial-viscosity coefficient q1 (dimensionless): q = rho (q2 du^2 - "
+                                   "q1 c_L du) in compression.", "nonnegative")
+    q_quadratic: float = setting(1.0, "Quadratic artificial-viscosity coefficient q2 (dimensionless).", "nonnegative")
 
     def numerics(self) -> Numerics:
         return Numerics(self.q_linear, self.q_quadratic, self.cfl, self.dt_initial_us, self.dt_max_us)

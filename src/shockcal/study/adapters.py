@@ -63,7 +63,7 @@ def material_properties(config: dict) -> MaterialProperties:
 
 def hydro_settings(config: dict) -> HydroSettings:
     """`hydro` (its `end_time_us` belongs to the geometry)."""
-    return HydroSettings(**{f.name: float(config["hydro"][f.name]) for f in fields(HydroSettings)})
+    return HydroSettings(**{name: config["hydro"][name] for name in HydroSettings.model_fields})
 
 
 def hydro_inputs(config: dict, spec: dict, end_us: float | None = None

@@ -22,6 +22,8 @@ from pathlib import Path
 import yaml
 
 from shockcal.errors import ConfigError
+from shockcal.hydro.settings import HydroSettings
+from shockcal.hydro.settings_model import schema_properties
 
 EXTENDS = "extends"
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -29,9 +31,18 @@ YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)   # libyaml's safe l
 FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value the study must give
 
 
+# Config sections whose keys are a library settings model's fields: the schema's entries for them are
+# generated from the model (`shockcal.hydro.settings_model.schema_properties`), the YAML holds only the rest.
+MODEL_SECTIONS = {"hydro": HydroSettings}
+
+
 @functools.lru_cache(maxsize=1)
 def _schema_text_parsed() -> dict:
-    return yaml.load(SCHEMA_PATH.read_text(), Loader=YAML_LOADER)
+    schema = yaml.load(SCHEMA_PATH.read_text(), Loader=YAML_LOADER)
+    for section, model in MODEL_SECTIONS.items():
+        entry = schema["properties"][section]
+        entry["properties"] = {**schema_properties(model, entry.get("required", [])), **entry["properties"]}
+    return schema
 
 
 def load_schema() -> dict:
