@@ -11,7 +11,6 @@ level; with it, it grows to the size of the time-step error.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from pathlib import Path
 
@@ -34,7 +33,7 @@ WINDOW_US = (1.0, 2.1)     # the 106S analysis window of these runs (arrival abo
 def run(C: float, cfl: float, velocity: float, inputs):
     geometry, material, settings = inputs
     params = ShotParameters.from_table_iv(0.008397, 0.008210, C, 0.458981, 2.26, velocity, 0.30)
-    return run_shot(params, geometry, material, dataclasses.replace(settings, cfl=cfl))
+    return run_shot(params, geometry, material, settings.replace(cfl=cfl))
 
 
 def main() -> None:

@@ -37,6 +37,7 @@ JC_104S = dict(A_MPa=335.0, B_MPa=425.0, C=0.0335, n=0.42, m=1.225, shear_modulu
      "LawShotParameters.velocity_m_s: 204000 is above 10000 m/s"),
     (lambda: HydroSettings(cell_size_um=0.0), "HydroSettings.cell_size_um: 0 is not a positive number"),
     (lambda: HydroSettings(cfl=1.5), "HydroSettings.cfl: 1.5 is above 1"),
+    (lambda: HydroSettings().replace(cfl=1.5), "HydroSettings.cfl: 1.5 is above 1"),
     (lambda: HydroSettings(q_linear=-0.1), "HydroSettings.q_linear: -0.1 is negative"),
     (lambda: MaterialProperties(**{**AL5083.__dict__, "c1_Mbar": -0.78}), "MaterialProperties.c1_Mbar: -0.78 is not a positive"),
     (lambda: MaterialProperties(**{**AL5083.__dict__, "c3_Mbar": np.inf}), "MaterialProperties.c3_Mbar: inf is not a finite"),

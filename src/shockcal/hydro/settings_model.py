@@ -35,6 +35,10 @@ class SettingsModel(BaseModel):
             where = ".".join(str(part) for part in error["loc"])
             raise InputError(f"{type(self).__name__}.{where}: {error['msg']}") from None
 
+    def replace(self, **changes):
+        """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
+        return type(self)(**{**self.model_dump(), **changes})
+
     @model_validator(mode="after")
     def _check_rules(self):
         check_fields(self, {name: extra[RULE] for name, extra in _extras(type(self)).items() if RULE in extra})
