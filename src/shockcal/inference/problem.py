@@ -120,14 +120,16 @@ class Problem:
         return [] if self.discrepancy is None else self.discrepancy.names
 
     def prior_transform(self, u: np.ndarray) -> np.ndarray:
-        """Unit cube (N, d + 1) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5))."""
+        """Unit cube (N, ndim) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5), the discrepancy's
+        parameters from their priors, `shockcal.inference.discrepancy`)."""
         u = np.atleast_2d(u)
         shape, rate = LAMBDA_Y_PRIOR
-        if self.discrepancy is not None:
-            d = len(self.names)
-            return np.column_stack([self.prior_transform(u[:, :d + 1]), self.discrepancy.prior_transform(u[:, d + 1:])])
-        theta = self.lower + u[:, :-1] * (self.upper - self.lower)
-        return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
+        d = len(self.names)
+        theta = self.lower + u[:, :d] * (self.upper - self.lower)
+        point = np.column_stack([theta, stats.gamma.ppf(u[:, d], shape, scale=1.0 / rate)])
+        if self.discrepancy is None:
+            return point
+        return np.column_stack([point, self.discrepancy.prior_transform(u[:, d + 1:])])
 
     def cube_power(self, powers: Mapping[str, float], others: str = "error") -> np.ndarray:
         """`nested_sample`'s per-coordinate unit-cube power from powers of named inputs (1 for the
