@@ -81,3 +81,26 @@ def test_wrong_settings_are_refused_in_one_line(setting, message):
     with pytest.raises(InputError, match=message) as info:
         from_setting(setting, FEATURES, 2)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("setting", ["gp", {"kind": "gp"}, {"kind": "feature_kind", "sd_fraction_prior": -0.1},
+                                     {"kind": "feature_kind", "rho": 0.5}])
+def test_the_config_refuses_what_the_library_refuses(paper_config, setting):
+    from shockcal.errors import ConfigError
+    from shockcal.study.validate import validate_config
+
+    paper_config["calibration"]["discrepancy"] = setting
+    with pytest.raises(ConfigError, match="calibration") as info:
+        validate_config(paper_config, source="config.yaml")
+    assert "\n" not in str(info.value)
+    with pytest.raises(InputError):
+        from_setting(setting, FEATURES, 2)
+
+
+def test_the_config_default_is_none_and_a_mapping_is_taken(paper_config_readonly, paper_config):
+    from shockcal.study.validate import validate_config
+
+    assert paper_config_readonly["calibration"]["discrepancy"] == "none"
+    paper_config["calibration"]["discrepancy"] = {"kind": "feature_kind", "sd_fraction_prior": 0.03}
+    setting = validate_config(paper_config, source="config.yaml")["calibration"]["discrepancy"]
+    assert from_setting(setting, FEATURES, 3) == Discrepancy(FEATURES, 3, 0.03)
