@@ -36,9 +36,9 @@ class Discrepancy:
     sd_fraction_prior: float = 0.02
 
     def __post_init__(self):
-        if not (np.isfinite(self.sd_fraction_prior) and self.sd_fraction_prior > 0):
+        if not (np.isfinite(self.sd_fraction_prior) and 0 < self.sd_fraction_prior <= 0.5):
             raise InputError(f"calibration.discrepancy.sd_fraction_prior = {self.sd_fraction_prior!r} is not a "
-                             "positive fraction (e.g. 0.02)")
+                             "positive fraction up to 0.5 (e.g. 0.02)")
 
     @property
     def names(self) -> list[str]:
