@@ -107,25 +107,3 @@ def test_the_config_default_is_none_and_a_mapping_is_taken(paper_config_readonly
     setting = validate_config(paper_config, source="config.yaml")["calibration"]["discrepancy"]
     assert from_setting(setting, FEATURES, 3) == Discrepancy(FEATURES, 3, 0.03)
 
-
-@pytest.mark.parametrize("setting", ["gp", {"kind": "feature_kind", "sd_fraction_prior": -0.1},
-                                     {"kind": "feature_kind", "rho": 0.5},
-                                     {"kind": "feature_kind", "sd_fraction_prior": 0.8}])
-def test_the_config_door_refuses_what_the_library_refuses(paper_config, setting):
-    from shockcal.errors import ConfigError
-    from shockcal.study.validate import validate_config
-
-    paper_config["calibration"]["discrepancy"] = setting
-    with pytest.raises(ConfigError, match=r"calibration\.discrepancy") as info:
-        validate_config(paper_config, source="config.yaml")
-    assert "\n" not in str(info.value)
-    with pytest.raises(InputError):
-        from_setting(setting, FEATURES, 2)
-
-
-def test_the_config_door_accepts_none_and_a_feature_kind_term(paper_config):
-    from shockcal.study.validate import validate_config
-
-    for setting in ("none", {"kind": "feature_kind", "sd_fraction_prior": 0.03}):
-        paper_config["calibration"]["discrepancy"] = setting
-        validate_config(paper_config, source="config.yaml")
