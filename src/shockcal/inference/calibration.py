@@ -37,6 +37,8 @@ class CalibrationSettings:
         check_training_range: whether a measured feature outside the training runs' range (widened by
             `shockcal.inference.training_range.RANGE_MARGIN`) stops the calibration before it starts (else a
             warning; config `checks.features_in_training_range`).
+        discrepancy: `calibration.discrepancy` ("none", or {kind: feature_kind, sd_fraction_prior}), the
+            model-discrepancy term (`shockcal.inference.discrepancy`); its parameters are fractions (-).
     """
 
     sampler: SamplerSettings = SamplerSettings()
@@ -48,6 +50,7 @@ class CalibrationSettings:
     velocity_boxes: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     check_plateau: bool = True
     check_training_range: bool = True
+    discrepancy: object = "none"
 
     def with_sampler(self, **changes) -> CalibrationSettings:
         """These settings with some sampler settings changed (e.g. `seed`, `n_eff`)."""
@@ -70,7 +73,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
         The `Posterior`; its `info` holds the shots, parameters, units and measured features too.
     """
     problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction, source, settings.bounds,
-                                settings.units)
+                                settings.units, settings.discrepancy)
     check_observed_table(observed, shots, source, settings.check_units)
     measured = {shot: dict(zip(emulator.feature_names, features))
                 for shot, features in zip(shots, problem.observed.reshape(len(shots), -1))}
@@ -81,7 +84,8 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
         check_training_range(measured, {shot: emulator.training_features(shot) for shot in shots}, source,
                              settings.check_training_range)
     posterior = sample(problem, settings.sampler, other_powers="ignore")
-    units = {**{k: settings.units.get(k, "-") for k in problem.names}, LAMBDA_Y: "-"}
+    units = {**{k: settings.units.get(k, "-") for k in problem.names}, LAMBDA_Y: "-",
+             **{k: "-" for k in problem.discrepancy_names}}
     posterior.units = units
     posterior.user_units = {k: settings.user_units.get(k, unit) for k, unit in units.items()}
     posterior.context.update(shots=list(shots), parameters=problem.names, units=units, user_units=posterior.user_units,

@@ -25,6 +25,7 @@ from scipy import stats
 
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.errors import InputError
+from shockcal.inference.discrepancy import Discrepancy, from_setting
 from shockcal.plausibility import outside_box
 
 LAMBDA_Y = "lambda_y"          # the observation-precision scale: its column in draws, designs and summaries
@@ -52,6 +53,7 @@ class Problem:
     upper: np.ndarray
     label: str = "calibration"
     error_groups: list[tuple[np.ndarray, ErrorModel]] | None = None
+    discrepancy: Discrepancy | None = None   # None: `calibration.discrepancy: none`, points (theta, lambda_y)
 
     @classmethod
     def from_emulator(cls, emulator, *, observed, sd_fraction: float = 0.01, names=None, label: str = "calibration"
@@ -72,8 +74,8 @@ class Problem:
 
     @classmethod
     def for_shots(cls, emulator, shots, observed_table: pd.DataFrame, sd_fraction: float, source: str = "observed",
-                  bounds: Mapping[str, tuple[float, float]] | None = None, units: Mapping[str, str] | None = None
-                  ) -> Problem:
+                  bounds: Mapping[str, tuple[float, float]] | None = None, units: Mapping[str, str] | None = None,
+                  discrepancy="none") -> Problem:
         """The study's problem: the inputs `shots` need, their box, and their measured features.
 
         Args:
@@ -87,6 +89,8 @@ class Problem:
             bounds: the prior box by input (native units; the study config's `inputs`), or None for the
                 emulator's box. It must lie inside the box the emulator was fitted on (`prior_box`).
             units: each input's unit, for messages.
+            discrepancy: `calibration.discrepancy` ("none", or {kind: feature_kind, sd_fraction_prior}:
+                `shockcal.inference.discrepancy`).
         """
         shots = list(shots)
         twice = sorted({shot for shot in shots if shots.count(shot) > 1})
@@ -103,18 +107,29 @@ class Problem:
             return emulator.predict(dict(zip(names, theta.T)), list(shots))
 
         return cls(predict, y, np.hypot(sd_fraction * np.abs(y), readout), names, np.asarray(lower), np.asarray(upper),
-                   "+".join(shots), emulator.error_groups(shots))
+                   "+".join(shots), emulator.error_groups(shots),
+                   from_setting(discrepancy, emulator.feature_names, len(shots)))
 
     @property
     def ndim(self) -> int:
-        return len(self.names) + 1
+        return len(self.names) + 1 + len(self.discrepancy_names)
+
+    @property
+    def discrepancy_names(self) -> list[str]:
+        """The discrepancy's sampled parameters (after lambda_y in a point), none without one."""
+        return [] if self.discrepancy is None else self.discrepancy.names
 
     def prior_transform(self, u: np.ndarray) -> np.ndarray:
-        """Unit cube (N, d + 1) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5))."""
+        """Unit cube (N, ndim) -> (theta uniform on the box, lambda_y ~ Gamma(5, 5), the discrepancy's
+        parameters from their priors, `shockcal.inference.discrepancy`)."""
         u = np.atleast_2d(u)
         shape, rate = LAMBDA_Y_PRIOR
-        theta = self.lower + u[:, :-1] * (self.upper - self.lower)
-        return np.column_stack([theta, stats.gamma.ppf(u[:, -1], shape, scale=1.0 / rate)])
+        d = len(self.names)
+        theta = self.lower + u[:, :d] * (self.upper - self.lower)
+        point = np.column_stack([theta, stats.gamma.ppf(u[:, d], shape, scale=1.0 / rate)])
+        if self.discrepancy is None:
+            return point
+        return np.column_stack([point, self.discrepancy.prior_transform(u[:, d + 1:])])
 
     def cube_power(self, powers: Mapping[str, float], others: str = "error") -> np.ndarray:
         """`nested_sample`'s per-coordinate unit-cube power from powers of named inputs (1 for the
@@ -124,27 +139,48 @@ class Problem:
         if unknown and others != "ignore":
             raise InputError(f"{self.label}: calibration.cube_power names {unknown}, not among the calibrated "
                              f"inputs {self.names}")
-        return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0])
+        return np.array([float(powers.get(name, 1.0)) for name in self.names] + [1.0] * (1 + len(self.discrepancy_names)))
 
     def log_likelihood(self, points: np.ndarray) -> np.ndarray:
         """Log-likelihood of the observed features at points (N, d + 1) = (theta, lambda_y)
         inside the box, normalising constants included (so the evidence is a true marginal likelihood).
         A non-finite value is an error naming the point: it means the emulator is broken there."""
         points = np.atleast_2d(points)
-        theta, lam = points[:, :-1], points[:, -1]
-        mean, cov = self.predict(theta)
-        resid = self.observed - mean
-        groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
-        value = np.zeros(len(points))
-        for cols, error in groups:
-            noise_var = self.obs_sd[cols] ** 2 / lam[:, None]
-            value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_var)
+        if self.discrepancy is not None:
+            value = self._log_likelihood_with_discrepancy(points)
+        else:
+            theta, lam = points[:, :-1], points[:, -1]
+            mean, cov = self.predict(theta)
+            resid = self.observed - mean
+            groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
+            value = np.zeros(len(points))
+            for cols, error in groups:
+                noise_var = self.obs_sd[cols] ** 2 / lam[:, None]
+                value += error.log_density(resid[:, cols], cov[:, cols[:, None], cols[None, :]], noise_var)
         bad = ~np.isfinite(value)
         if bad.any():
-            point = dict(zip([*self.names, LAMBDA_Y], points[np.argmax(bad)].tolist()))
+            point = dict(zip([*self.names, LAMBDA_Y, *self.discrepancy_names], points[np.argmax(bad)].tolist()))
             raise InputError(f"{self.label}: the log-likelihood is not finite at {point} "
                              "(the emulator's prediction or covariance is invalid there)")
         return value
+
+    def _log_likelihood_with_discrepancy(self, points: np.ndarray) -> np.ndarray:
+        """One joint Gaussian over all features: the blocks' emulator covariances (each scaled by its
+        error model's s) block-diagonal, plus Sigma_delta (correlated across shots, so across blocks),
+        plus the noise. A Student-t block cannot share a Gaussian across blocks: refused."""
+        d = len(self.names)
+        theta, lam, phi = points[:, :d], points[:, d], points[:, d + 1:]
+        mean, cov = self.predict(theta)
+        groups = self.error_groups or [(np.arange(len(self.observed)), ErrorModel())]
+        total = self.discrepancy.covariance(phi, self.observed) + \
+            (self.obs_sd ** 2 / lam[:, None])[:, :, None] * np.eye(len(self.observed))
+        for cols, error in groups:
+            if np.isfinite(error.dof):
+                raise InputError(f"{self.label}: calibration.discrepancy needs Gaussian emulator errors, and a block "
+                                 f"has a Student t (dof {error.dof:g}); set the emulator's error model to gaussian "
+                                 "or calibration.discrepancy: none")
+            total[:, cols[:, None], cols[None, :]] += error.scale * cov[:, cols[:, None], cols[None, :]]
+        return ErrorModel().log_density(self.observed - mean, total)
 
     def hydrocode_log_likelihood(self, features: np.ndarray, lambda_y: np.ndarray) -> np.ndarray:
         """Log-likelihood of the observed features when the predicted features are known exactly (a
@@ -159,6 +195,9 @@ class Problem:
         """Log posterior (up to a constant) at x (N, d + 1) = (theta, log lambda_y); -inf outside the
         box. The Gamma prior of lambda_y and the Jacobian of the log are included."""
         x = np.atleast_2d(x)
+        if self.discrepancy is not None:
+            raise InputError(f"{self.label}: calibration.discrepancy is sampled by nested sampling only (nautilus); "
+                             "log_posterior covers (theta, log lambda_y)")
         out = np.full(len(x), -np.inf)
         inside = np.all((x[:, :-1] >= self.lower) & (x[:, :-1] <= self.upper), axis=1) & np.isfinite(x[:, -1])
         if inside.any():

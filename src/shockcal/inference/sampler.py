@@ -316,7 +316,7 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
                           settings.max_evaluations)
             for r in range(settings.replicates)]
     weighted = runs[0] if len(runs) == 1 else pool(runs)
-    names = [*problem.names, LAMBDA_Y]
+    names = [*problem.names, LAMBDA_Y, *problem.discrepancy_names]
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     draws = pd.DataFrame(weighted.points[rows], columns=names)
     draws["log_likelihood"] = weighted.log_likelihood[rows]

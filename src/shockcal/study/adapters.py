@@ -192,7 +192,8 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
                                user_units=input_user_units(config), bounds=prior_bounds(config),
                                velocity_boxes={shot: box for shot, box in boxes.items() if box is not None},
                                check_plateau=config["checks"]["plateau_vs_velocity"],
-                               check_training_range=config["checks"]["features_in_training_range"] and not check)
+                               check_training_range=config["checks"]["features_in_training_range"] and not check,
+                               discrepancy=config["calibration"].get("discrepancy", "none"))
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False

@@ -1,0 +1,95 @@
+"""The model-discrepancy term of a calibration (issue 63): delta ~ N(0, Sigma_delta), marginalised.
+
+    y = eta(theta) + delta + e + eps,   delta ~ N(0, Sigma_delta(phi)),
+
+Sigma_delta over the feature kinds (four per shot): feature i of kind k on shot s has sd
+f_k |y_i| (f_k = `delta_sd_fraction_<kind>`, a fraction of the measured feature), two features of
+the same kind on different shots correlate by rho (`delta_rho_shots`, one for all kinds), features
+of different kinds are independent. It is a statement about the strength law's form: an error that
+repeats across shots in proportion to each feature. It is not a per-shot free bias (confounded with
+the per-shot impact velocity and moduli: Brynjarsdottir and O'Hagan 2014), and not a per-shot timing
+shift. Priors: f_k half-normal with sd `sd_fraction_prior` (0.02: "a few %" of each feature, with
+mass at 0 so that records without a discrepancy can shrink it), rho uniform on [0, 1].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+from shockcal.errors import InputError
+
+KINDS = ("none", "feature_kind")
+RHO_NAME = "delta_rho_shots"
+
+
+@dataclass(frozen=True)
+class Discrepancy:
+    """A feature-kind discrepancy over `feature_names` (the per-shot feature kinds, in order) for
+    `n_shots` shots, shot-major like the observed vector; `sd_fraction_prior` the half-normal sd of
+    each kind's fraction (dimensionless, > 0)."""
+
+    feature_names: tuple[str, ...]
+    n_shots: int
+    sd_fraction_prior: float = 0.02
+
+    def __post_init__(self):
+        if not (np.isfinite(self.sd_fraction_prior) and 0 < self.sd_fraction_prior <= 0.5):
+            raise InputError(f"calibration.discrepancy.sd_fraction_prior = {self.sd_fraction_prior!r} is not a "
+                             "positive fraction up to 0.5 (e.g. 0.02)")
+
+    @property
+    def names(self) -> list[str]:
+        """The sampled parameters' names: one sd fraction per feature kind, then rho."""
+        return [f"delta_sd_fraction_{name}" for name in self.feature_names] + [RHO_NAME]
+
+    def prior_transform(self, u: np.ndarray) -> np.ndarray:
+        """Unit cube (N, kinds + 1) -> (fractions half-normal(0, sd_fraction_prior), rho uniform [0, 1])."""
+        u = np.atleast_2d(u)
+        fractions = self.sd_fraction_prior * stats.halfnorm.ppf(u[:, :-1])
+        return np.column_stack([fractions, u[:, -1]])
+
+    def log_prior(self, phi: np.ndarray) -> np.ndarray:
+        """Log prior density of phi (N, kinds + 1); -inf outside the support."""
+        phi = np.atleast_2d(phi)
+        fractions, rho = phi[:, :-1], phi[:, -1]
+        value = stats.halfnorm.logpdf(fractions, scale=self.sd_fraction_prior).sum(1)
+        return np.where((rho >= 0) & (rho <= 1), value, -np.inf)
+
+    def covariance(self, phi: np.ndarray, observed: np.ndarray) -> np.ndarray:
+        """Sigma_delta (N, F, F), (m/s)^2, at phi (N, kinds + 1) for the observed features (F,) m/s."""
+        phi = np.atleast_2d(phi)
+        k = len(self.feature_names)
+        kind = np.tile(np.arange(k), self.n_shots)
+        shot = np.repeat(np.arange(self.n_shots), k)
+        same_kind = kind[:, None] == kind[None, :]
+        same_shot = shot[:, None] == shot[None, :]
+        sd = phi[:, kind] * np.abs(observed)[None, :]                      # (N, F)
+        corr = np.where(same_kind & same_shot, 1.0, 0.0)[None] + \
+            np.where(same_kind & ~same_shot, 1.0, 0.0)[None] * phi[:, -1, None, None]
+        return sd[:, :, None] * corr * sd[:, None, :]
+
+
+def from_setting(setting, feature_names, n_shots: int, source: str = "calibration.discrepancy") -> Discrepancy | None:
+    """The discrepancy a config's `calibration.discrepancy` asks for: "none" (or absent) -> None; a
+    mapping {kind: feature_kind, sd_fraction_prior: float}. Anything else is one-line InputError."""
+    if setting is None or setting == "none":
+        return None
+    if isinstance(setting, str):
+        setting = {"kind": setting}
+    if not isinstance(setting, dict):
+        raise InputError(f"{source} = {setting!r}: give 'none' or {{kind: feature_kind, sd_fraction_prior: 0.02}}")
+    unknown = sorted(set(setting) - {"kind", "sd_fraction_prior"})
+    if unknown:
+        raise InputError(f"{source}: unknown key(s) {unknown}; allowed: kind, sd_fraction_prior")
+    kind = setting.get("kind", "feature_kind")
+    if kind not in KINDS:
+        raise InputError(f"{source}.kind = {kind!r} is not one of {list(KINDS)}")
+    if kind == "none":
+        return None
+    prior = setting.get("sd_fraction_prior", 0.02)
+    if isinstance(prior, bool) or not isinstance(prior, (int, float)):
+        raise InputError(f"{source}.sd_fraction_prior = {prior!r} is not a number")
+    return Discrepancy(tuple(feature_names), int(n_shots), float(prior))
