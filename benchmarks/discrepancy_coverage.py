@@ -5,7 +5,7 @@ discrepancy drawn from the term's prior (`--records prior`) or none (`--records 
 Each truth is calibrated with `none` and with `feature_kind` (nautilus); prints the 90%-interval coverage
 of every input and of the discrepancy's scale, and the cost. A provisional toy: the study's check is `make check`.
 
-    nice -n 10 .venv/bin/python benchmarks/bench_discrepancy_toy.py --truths 30 --records prior
+    nice -n 10 .venv/bin/python benchmarks/discrepancy_coverage.py --truths 30 --records prior
 """
 
 import argparse
