@@ -301,7 +301,8 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
     """Sample a problem's posterior with nautilus.
 
     Args:
-        problem: a `shockcal.inference.problem.Problem` (prior transform, batch log-likelihood, names).
+        problem: a `shockcal.inference.problem.Problem` (prior transform, batch log-likelihood, names; a
+            stand-in without a discrepancy need not have `discrepancy_names`).
         settings: the sampler's settings.
         other_powers: `Problem.cube_power`'s `others` ("error": a power of an input the problem does
             not calibrate is an error; "ignore": skipped).
@@ -316,7 +317,7 @@ def sample(problem, settings: SamplerSettings, other_powers: str = "error") -> P
                           settings.max_evaluations)
             for r in range(settings.replicates)]
     weighted = runs[0] if len(runs) == 1 else pool(runs)
-    names = [*problem.names, LAMBDA_Y, *problem.discrepancy_names]
+    names = [*problem.names, LAMBDA_Y, *getattr(problem, "discrepancy_names", ())]
     rows = weighted.resample(settings.draws, np.random.default_rng(settings.seed))
     draws = pd.DataFrame(weighted.points[rows], columns=names)
     draws["log_likelihood"] = weighted.log_likelihood[rows]
