@@ -224,3 +224,15 @@ def test_law_kernels_load_from_numba_cache_in_a_second_process(tmp_path):
     assert first.returncode == 0 and second.returncode == 0, first.stderr + second.stderr
     assert first.stdout.split() == ["0", "1"]          # compiled and saved
     assert second.stdout.split() == ["1", "0"]         # loaded
+
+
+def test_a_flow_stress_from_the_cached_hardening_is_the_laws_own_bit_for_bit():
+    """Johnson-Cook's `flow_stress_from_hardening` (the solver's cached A + B eps_p^n) equals its flow stress
+    exactly over plastic strains, rates (below and above the reference) and temperatures (cold, hot, molten)."""
+    law = get_law("johnson-cook")
+    params = code_parameters(law, {"A_MPa": 170.0, "B_MPa": 425.0, "C": 0.0335, "n": 0.42, "m": 1.225},
+                             load_material("al5083"))
+    rng = np.random.default_rng(3)
+    for eps_p, rate, T in zip(rng.uniform(0, 0.3, 200), 10 ** rng.uniform(-8, 1, 200), rng.uniform(250, 950, 200)):
+        hard = law.hardening(params, eps_p)
+        assert law.flow_stress_from_hardening(params, hard, rate, T) == law.flow_stress(params, eps_p, rate, T, 0.0, 1.0)

@@ -15,7 +15,7 @@ from __future__ import annotations
 from numba import njit
 
 from shockcal.hydro.laws.kernels import (
-    law_flow_stress_at,
+    law_flow_stress_cached,
     law_flow_stress_floor,
     law_hardening,
     law_remember_floor,
@@ -45,7 +45,7 @@ def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_fl
     floor = law_flow_stress_floor(law, hard, G, rate, T_cell, eta, flow_floor, floor_hotter, floor_T)
     if 1.5 * abs(s_trial) <= LAW_FLOOR_SLACK * floor:
         return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    s_new, d_eps = radial_return(s_trial, law_flow_stress_at(law, G, eps_p, rate, T_cell, P, eta), G)
+    s_new, d_eps = radial_return(s_trial, law_flow_stress_cached(law, hard, G, eps_p, rate, T_cell, P, eta), G)
     if d_eps > 0.0:
         eps_p += d_eps
         hard = law_hardening(law, eps_p)

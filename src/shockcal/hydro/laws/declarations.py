@@ -18,6 +18,7 @@ from shockcal.hydro.laws.johnson_cook import (
     JohnsonCook,
     johnson_cook_flow_stress,
     johnson_cook_flow_stress_floor,
+    johnson_cook_flow_stress_from_hardening,
     johnson_cook_hardening,
     johnson_cook_remember_floor,
 )
@@ -92,11 +93,13 @@ class Law:
     the cell's G, not recomputed), `flow_stress_floor(law, hard, G, rate, T, eta, flow_floor, floor_hotter,
     floor_T)`, a proven lower bound of the flow stress from `hardening(law, eps_p)`, which the solver caches
     per cell, and from the floor `remember_floor(law, G, eps_p, rate, T, eta, ...)` sets after a full
-    evaluation found the cell elastic. A study's design columns (`column`): the kernel's fields in code units
-    for a law with `code_unit_columns` (Johnson-Cook, whose box a study gives in `inputs`), else the declared
-    names in user units (a box in `strength.inputs` or config/models.yaml). `roles` names the parameters
-    that study code reads by their part in the law (`role_column`): the emulator's power inputs
-    (eps^n, T*^m) and the next-shot check's initial yield stress."""
+    evaluation found the cell elastic; `flow_stress_from_hardening(law, hard, rate, T)`, the flow stress from
+    that cached hardening (for a law whose flow stress is its hardening times factors of rate and T). A
+    study's design columns (`column`): the kernel's fields in code units for a law with `code_unit_columns`
+    (Johnson-Cook, whose box a study gives in `inputs`), else the declared names in user units (a box in
+    `strength.inputs` or config/models.yaml). `roles` names the parameters that study code reads by their
+    part in the law (`role_column`): the emulator's power inputs (eps^n, T*^m) and the next-shot check's
+    initial yield stress."""
 
     name: str
     title: str
@@ -111,6 +114,7 @@ class Law:
     hardening: Callable | None = None
     flow_stress_floor: Callable | None = None
     remember_floor: Callable | None = None
+    flow_stress_from_hardening: Callable | None = None
     code_unit_columns: bool = False
     roles: Mapping[str, str] = field(default_factory=dict)
 
@@ -155,7 +159,7 @@ JOHNSON_COOK = Law(
                  ("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0)),
     melt_temperature=lambda law, eta: law.T_melt,
     hardening=johnson_cook_hardening, flow_stress_floor=johnson_cook_flow_stress_floor,
-    remember_floor=johnson_cook_remember_floor,
+    remember_floor=johnson_cook_remember_floor, flow_stress_from_hardening=johnson_cook_flow_stress_from_hardening,
     code_unit_columns=True,
     roles={"yield_stress": "A_MPa", "rate_coefficient": "C", "hardening_exponent": "n", "thermal_exponent": "m"},
 )

@@ -50,6 +50,14 @@ def johnson_cook_flow_stress(law, eps_p, strain_rate, T, P, eta):
 
 
 @njit(cache=True, error_model="numpy")
+def johnson_cook_flow_stress_from_hardening(law, hard, strain_rate, T):
+    """The flow stress (Mbar) from the cell's cached hardening `hard` (A + B eps_p^n, Mbar), the equivalent strain
+    rate (1/us) and T (K): `johnson_cook_flow_stress` bit for bit (the same product in the same order), without
+    recomputing eps_p^n."""
+    return hard * rate_factor(law.C, strain_rate, law.rate_ref) * thermal_factor(law.m, _homologous(law, T))
+
+
+@njit(cache=True, error_model="numpy")
 def _homologous(law, T):
     """T* = (T - T_ref) / (T_melt - T_ref), in the hydrocode's order of operations."""
     return (T - law.T_ref) * (1.0 / (law.T_melt - law.T_ref))

@@ -6,6 +6,8 @@ compiles (no run-time branch, no function objects passed around, so callers stay
                                                       without one: Johnson-Cook, Zerilli-Armstrong)
     law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta) -> Mbar   (with the cell's G from
                                                       law_shear_modulus, which the law does not recompute)
+    law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta) -> Mbar   (law_flow_stress_at, from the
+                                                      cell's cached hardening `hard` where the law can use it)
     law_hardening(law, eps_p) -> the law's cached hardening (0 for laws without one)
     law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T) -> Mbar
         (a proven lower bound of the flow stress from the cell's cached hardening and remembered floor,
@@ -69,6 +71,24 @@ def law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
     if kernel is None:
         return law_flow_stress(law, eps_p, strain_rate, T, P, eta)
     return kernel(law, G, eps_p, strain_rate, T, P, eta)
+
+
+def law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
+    """`law_flow_stress_at`, read from the cell's cached hardening `hard` (`law_hardening(law, eps_p)`) by a law
+    that declares `flow_stress_from_hardening` (the same value bit for bit)."""
+    kernel = _law_of(type(law)).flow_stress_from_hardening
+    if kernel is None:
+        return law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta)
+    return kernel(law, hard, strain_rate, T)
+
+
+@overload(law_flow_stress_cached, jit_options={"cache": True})
+def _law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
+    kernel = _law_of(law).flow_stress_from_hardening
+    if kernel is None:
+        return lambda law, hard, G, eps_p, strain_rate, T, P, eta: law_flow_stress_at(law, G, eps_p, strain_rate, T,
+                                                                                     P, eta)
+    return lambda law, hard, G, eps_p, strain_rate, T, P, eta: kernel(law, hard, strain_rate, T)
 
 
 def law_hardening(law, eps_p):
