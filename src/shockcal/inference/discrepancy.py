@@ -51,13 +51,6 @@ class Discrepancy:
         fractions = self.sd_fraction_prior * stats.halfnorm.ppf(u[:, :-1])
         return np.column_stack([fractions, u[:, -1]])
 
-    def log_prior(self, phi: np.ndarray) -> np.ndarray:
-        """Log prior density of phi (N, kinds + 1); -inf outside the support."""
-        phi = np.atleast_2d(phi)
-        fractions, rho = phi[:, :-1], phi[:, -1]
-        value = stats.halfnorm.logpdf(fractions, scale=self.sd_fraction_prior).sum(1)
-        return np.where((rho >= 0) & (rho <= 1), value, -np.inf)
-
     def covariance(self, phi: np.ndarray, observed: np.ndarray) -> np.ndarray:
         """Sigma_delta (N, F, F), (m/s)^2, at phi (N, kinds + 1) for the observed features (F,) m/s."""
         phi = np.atleast_2d(phi)
@@ -89,7 +82,7 @@ def from_setting(setting, feature_names, n_shots: int, source: str = "calibratio
         raise InputError(f"{source}.kind = {kind!r} is not one of {list(KINDS)}")
     if kind == "none":
         return None
-    prior = setting.get("sd_fraction_prior", 0.02)
+    prior = setting.get("sd_fraction_prior", Discrepancy.sd_fraction_prior)
     if isinstance(prior, bool) or not isinstance(prior, (int, float)):
         raise InputError(f"{source}.sd_fraction_prior = {prior!r} is not a number")
     return Discrepancy(tuple(feature_names), int(n_shots), float(prior))
