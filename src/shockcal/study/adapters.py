@@ -9,14 +9,15 @@ extractor's modules are imported by their adapters, so that a simulate job does 
 
 from __future__ import annotations
 
-from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.seeds import stream_seed
+from shockcal.settings_model import section_fields
 from shockcal.study.config import (
     AUTO_END_MARGIN_US,
     PER_RUN_RISE_FRACTION,
@@ -34,7 +35,6 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from shockcal.campaign.candidates import Candidate
-    from shockcal.emulator.pcgp import Settings as EmulatorSettings
     from shockcal.emulator.study_emulator import EmulatorSpec
     from shockcal.inference.calibration import CalibrationSettings
     from shockcal.velocimetry.features import ExtractorSettings
@@ -135,11 +135,8 @@ def candidate_box(config: dict, name: str) -> InputBox:
 
 def emulator_settings(config: dict) -> EmulatorSettings:
     """`emulator` (the GP settings by name), seeded by study.seed."""
-    from shockcal.emulator.pcgp import Settings as EmulatorSettings
-
-    section = config["emulator"]
-    names = {f.name for f in fields(EmulatorSettings)} - {"seed"}
-    return EmulatorSettings(seed=config["study"]["seed"], **{k: section[k] for k in names if k in section})
+    return EmulatorSettings(seed=config["study"]["seed"],
+                            **{name: config["emulator"][name] for name in section_fields(EmulatorSettings)})
 
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:

@@ -21,9 +21,10 @@ from pathlib import Path
 
 import yaml
 
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.settings import HydroSettings
-from shockcal.hydro.settings_model import schema_properties
+from shockcal.settings_model import schema_properties
 
 EXTENDS = "extends"
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -32,8 +33,9 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 
 
 # Config sections whose keys are a library settings model's fields: the schema's entries for them are
-# generated from the model (`shockcal.hydro.settings_model.schema_properties`), the YAML holds only the rest.
-MODEL_SECTIONS = {"hydro": HydroSettings}
+# generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest.
+MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings}
+AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
 @functools.lru_cache(maxsize=1)
@@ -41,8 +43,20 @@ def _schema_text_parsed() -> dict:
     schema = yaml.load(SCHEMA_PATH.read_text(), Loader=YAML_LOADER)
     for section, model in MODEL_SECTIONS.items():
         entry = schema["properties"][section]
-        entry["properties"] = {**schema_properties(model, entry.get("required", [])), **entry["properties"]}
+        entry["properties"] = _placed(schema_properties(model, entry.get("required", [])), entry["properties"])
     return schema
+
+
+def _placed(generated: dict, written: dict) -> dict:
+    """A model section's properties in their order: the model's fields, and each key the YAML writes after
+    the key its `x-after` names, else after the YAML key before it (the first one: first). The order is the
+    order a validated config holds the section's keys in, which the workflow's rerun triggers compare."""
+    keys, previous = list(generated), None
+    for name, entry in written.items():
+        after = entry.pop(AFTER, previous)
+        keys.insert(keys.index(after) + 1 if after is not None else 0, name)
+        previous = name
+    return {name: generated[name] if name in generated else written[name] for name in keys}
 
 
 def load_schema() -> dict:

@@ -1,0 +1,83 @@
+"""The base of the library's settings that are also config sections: a frozen pydantic model whose fields
+carry their default, limits, unit and description once (`setting`), rendered into the config schema's
+entries for the section (`schema_properties`).
+
+A field's choices are its type (`Literal["a", "b"]`: the schema's `enum`), its limits pydantic's `ge`, `gt`,
+`le`, `lt` (the schema's `minimum`, `exclusiveMinimum`, `maximum`, `exclusiveMaximum`), so the config and
+the library refuse the same values. A bad value is one InputError line naming the class and the field,
+never a pydantic traceback. It sits beside `shockcal.errors` on the ground floor: the hydrocode's settings
+(`shockcal.hydro.settings_model` adds its physical rules) and the emulator's build on it.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, get_args, get_origin
+
+import annotated_types
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from shockcal.errors import InputError, shown
+
+KEY = "x-key"       # a field the config gives elsewhere than in the model's section (e.g. `study.seed`)
+TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", int | float: "number"}
+LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exclusiveMinimum"),
+          (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"))
+
+
+def setting(default, description: str, unit: str | None = None, key: str | None = None, extra: dict | None = None,
+            **limits):
+    """A settings field: its `default`, its `description` (the config page's text), its unit when its name
+    does not say it, the config `key` that gives it when that is not its section's key of its name, further
+    schema keywords `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt)."""
+    schema = {name: value for name, value in (("x-unit", unit), (KEY, key)) if value is not None} | (extra or {})
+    return Field(default, description=description, json_schema_extra=schema or None, **limits)
+
+
+class SettingsModel(BaseModel):
+    """Frozen, no unknown fields; a wrong type, choice or limit is one InputError line naming the field."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    def __init__(self, **values):
+        try:
+            super().__init__(**values)
+        except ValidationError as exc:
+            error = exc.errors()[0]
+            where = ".".join(str(part) for part in error["loc"])
+            value = "" if error["type"] == "missing" else f" {shown(error['input'])}"
+            raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}") from None
+
+    def replace(self, **changes):
+        """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
+        return type(self)(**{**self.model_dump(), **changes})
+
+
+def schema_extras(model: type[SettingsModel]) -> dict[str, dict]:
+    """{field: its schema keywords given to `setting` (x-unit, x-key, extra)}."""
+    return {name: dict(field.json_schema_extra or {}) for name, field in model.model_fields.items()}
+
+
+def section_fields(model: type[SettingsModel]) -> list[str]:
+    """The fields of `model` that are keys of its config section (not given elsewhere, `setting(key=...)`)."""
+    return [name for name, extra in schema_extras(model).items() if KEY not in extra]
+
+
+def schema_properties(model: type[SettingsModel], required: list[str] = ()) -> dict[str, dict]:
+    """The config schema's `properties` of `model`'s section fields, in the schema's own words (`type` or
+    `enum`, the limits, the `x-` keywords, `default`, `description`); a key the config section `required`
+    gets no default."""
+    properties = {}
+    for name in section_fields(model):
+        field = model.model_fields[name]
+        if get_origin(field.annotation) is Literal:
+            entry = {"enum": list(get_args(field.annotation))}
+        else:
+            entry = {"type": TYPES[field.annotation]}
+        for limit in field.metadata:
+            entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+        entry |= schema_extras(model)[name]
+        if name not in required:
+            entry["default"] = field.default
+        entry["description"] = field.description
+        properties[name] = entry
+    return properties
