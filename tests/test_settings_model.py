@@ -1,5 +1,5 @@
-"""The settings models that are config sections (`shockcal.settings_model`): the emulator's settings refuse on
-construction what the config's `emulator` section refuses, each door naming the key, and the config reaches
+"""The settings models that are config sections (`shockcal.settings_model`): the emulator's and the extractor's
+settings refuse on construction what the config refuses, each door naming the key, and the config reaches
 them by name; a model section's keys keep their order in a validated config."""
 
 from __future__ import annotations
@@ -9,9 +9,10 @@ import pytest
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError, InputError
 from shockcal.settings_model import section_fields
-from shockcal.study.adapters import emulator_settings
+from shockcal.study.adapters import emulator_settings, extractor_settings
 from shockcal.study.config_files import _placed
 from shockcal.study.validate import validate_config
+from shockcal.velocimetry.settings import ExtractorSettings
 
 
 @pytest.mark.parametrize("key, value", [
@@ -66,3 +67,29 @@ def test_the_emulator_sections_keys_keep_their_order(paper_config):
         "structure", "n_components", "n_starts", "max_fit_runs", "family", "fit_mean", "hardening_strain",
         "homologous_temperature", "yield_input", "n_jobs", "cv_folds", "calibrate_sd", "cv_warm_start",
         "switch_ratio", "sd_model", "error_tails", "outer_margin"]
+
+
+@pytest.mark.parametrize("section, key, value", [
+    ("shots.104S.analysis", "window_after_arrival_us", 0.0), ("shots.104S.analysis", "cutoff_after_arrival_us", -0.01),
+    ("features", "n_components", 1), ("features", "n_samples", 99), ("features", "n_samples", 1e4 + 0.5),
+    ("shots.104S.analysis", "window_after_arrival_us", "1.2 us"),
+])
+def test_both_doors_refuse_a_bad_extractor_setting_naming_it(paper_config, section, key, value):
+    node = paper_config
+    for part in section.split("."):
+        node = node[part]
+    node[key] = value
+    with pytest.raises(ConfigError, match=rf"^config\.yaml: {section.replace('.', r'[.]')}\.{key}: "):
+        validate_config(paper_config, source="config.yaml")
+    with pytest.raises(InputError, match=rf"^ExtractorSettings\.{key} .*: [^\n]+$"):
+        ExtractorSettings(**{key: value})
+
+
+def test_the_extractor_reads_its_shots_window_and_the_studys_mixture(paper_config):
+    """Two config sections, one library setting: the shot's `analysis` and the study's `features`."""
+    paper_config["shots"]["105S"]["analysis"] = {"window_after_arrival_us": 0.9}
+    paper_config["features"] = {"n_samples": 2000}
+    config = validate_config(paper_config)
+    assert extractor_settings(config, "105S") == ExtractorSettings(window_after_arrival_us=0.9, n_samples=2000)
+    assert extractor_settings(config, "104S").window_after_arrival_us == config["shots"]["104S"]["analysis"][
+        "window_after_arrival_us"]

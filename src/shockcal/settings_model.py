@@ -18,19 +18,22 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from shockcal.errors import InputError, shown
 
-KEY = "x-key"       # a field the config gives elsewhere than in the model's section (e.g. `study.seed`)
+KEY = "x-key"            # a field the config gives by a key of its own (e.g. `study.seed`), not generated
+SECTION = "x-section"    # a field that is a key of another config section than the model's own (generated there)
 TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", int | float: "number"}
 LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exclusiveMinimum"),
           (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"))
 
 
-def setting(default, description: str, unit: str | None = None, key: str | None = None, extra: dict | None = None,
-            **limits):
+def setting(default, description: str, unit: str | None = None, key: str | None = None, section: str | None = None,
+            extra: dict | None = None, **limits):
     """A settings field: its `default`, its `description` (the config page's text), its unit when its name
-    does not say it, the config `key` that gives it when that is not its section's key of its name, further
-    schema keywords `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt)."""
-    schema = {name: value for name, value in (("x-unit", unit), (KEY, key)) if value is not None} | (extra or {})
-    return Field(default, description=description, json_schema_extra=schema or None, **limits)
+    does not say it, the config `key` that gives it when no section of the model's holds it (e.g.
+    `study.seed`: not generated), the config `section` it is a key of when that is not the model's own
+    (dotted, `*` for every key of a mapping: `shots.*.analysis`; generated there), further schema keywords
+    `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt)."""
+    schema = {name: value for name, value in (("x-unit", unit), (KEY, key), (SECTION, section)) if value is not None}
+    return Field(default, description=description, json_schema_extra=(schema | (extra or {})) or None, **limits)
 
 
 class SettingsModel(BaseModel):
@@ -57,17 +60,24 @@ def schema_extras(model: type[SettingsModel]) -> dict[str, dict]:
     return {name: dict(field.json_schema_extra or {}) for name, field in model.model_fields.items()}
 
 
-def section_fields(model: type[SettingsModel]) -> list[str]:
-    """The fields of `model` that are keys of its config section (not given elsewhere, `setting(key=...)`)."""
-    return [name for name, extra in schema_extras(model).items() if KEY not in extra]
+def section_fields(model: type[SettingsModel], section: str | None = None) -> list[str]:
+    """The fields of `model` that are keys of config section `section` (`setting(section=...)`); None: of the
+    model's own section (the fields that name no other section and no key of their own)."""
+    return [name for name, extra in schema_extras(model).items() if KEY not in extra and extra.get(SECTION) == section]
 
 
-def schema_properties(model: type[SettingsModel], required: list[str] = ()) -> dict[str, dict]:
-    """The config schema's `properties` of `model`'s section fields, in the schema's own words (`type` or
-    `enum`, the limits, the `x-` keywords, `default`, `description`); a key the config section `required`
-    gets no default."""
+def other_sections(model: type[SettingsModel]) -> list[str]:
+    """The config sections besides its own that `model`'s fields are keys of (`setting(section=...)`)."""
+    return list(dict.fromkeys(extra[SECTION] for extra in schema_extras(model).values() if SECTION in extra))
+
+
+def schema_properties(model: type[SettingsModel], required: list[str] = (), section: str | None = None
+                      ) -> dict[str, dict]:
+    """The config schema's `properties` of `model`'s fields in config `section` (None: its own), in the
+    schema's own words (`type` or `enum`, the limits, the `x-` keywords but x-section, `default`,
+    `description`); a key the config section `required` gets no default."""
     properties = {}
-    for name in section_fields(model):
+    for name in section_fields(model, section):
         field = model.model_fields[name]
         if get_origin(field.annotation) is Literal:
             entry = {"enum": list(get_args(field.annotation))}
@@ -75,7 +85,7 @@ def schema_properties(model: type[SettingsModel], required: list[str] = ()) -> d
             entry = {"type": TYPES[field.annotation]}
         for limit in field.metadata:
             entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
-        entry |= schema_extras(model)[name]
+        entry |= {keyword: value for keyword, value in schema_extras(model)[name].items() if keyword != SECTION}
         if name not in required:
             entry["default"] = field.default
         entry["description"] = field.description

@@ -2,9 +2,9 @@
 
 Each adapter takes a validated config (or the slice its stage reads, `shockcal.study.stages`) and
 returns what a library function takes; the library never sees a dict. Field names of the settings
-are the config's keys, so most adapters copy by name. The emulator's, the calibration's and the
-extractor's modules are imported by their adapters, so that a simulate job does not pay for them
-(0.7 s a job).
+are the config's keys, so most adapters copy by name. The emulator's and the calibration's modules are
+imported by their adapters, so that a simulate job does not pay for them (0.7 s a job); the settings
+models of the emulator and the extractor are light modules of their own.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from shockcal.study.config import (
     wave_sizes,
 )
 from shockcal.study.strength_config import material_constants, strength_law, strength_parameters
+from shockcal.velocimetry.settings import ExtractorSettings
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
     from shockcal.campaign.candidates import Candidate
     from shockcal.emulator.study_emulator import EmulatorSpec
     from shockcal.inference.calibration import CalibrationSettings
-    from shockcal.velocimetry.features import ExtractorSettings
 
 
 def input_box(config: dict) -> InputBox:
@@ -85,14 +85,12 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
 
 def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
     """`shots.<shot>.analysis` and `features`."""
-    from shockcal.velocimetry.features import ExtractorSettings
 
     return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
 
 
 def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
     """A next-shot candidate's analysis window (`candidate_config`) and `features`."""
-    from shockcal.velocimetry.features import ExtractorSettings
 
     return ExtractorSettings(**candidate_config(config, name)["analysis"], **config["features"])
 
