@@ -116,7 +116,7 @@ SETTINGS = [
     ("shockcal.hydro:HydroSettings", ["hydro"], {}, True),
     ("shockcal.hydro:Geometry", ["shots.*", "hydro"], {}, False),
     ("shockcal.hydro:MaterialProperties", ["material", "material.eos"], {}, False),
-    ("shockcal.velocimetry.features:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
+    ("shockcal.velocimetry.settings:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
     ("shockcal.emulator.settings:EmulatorSettings", ["emulator"], {"seed": "study.seed"}, False),
     ("shockcal.emulator.yield_input:YieldInput", ["emulator.yield_input"], {}, False),
     ("shockcal.inference.sampler:SamplerSettings", ["calibration"], {}, False),

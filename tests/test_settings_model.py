@@ -18,7 +18,8 @@ from shockcal.velocimetry.settings import ExtractorSettings
 @pytest.mark.parametrize("key, value", [
     ("n_components", 0), ("n_components", -0.5), ("n_starts", 0), ("max_fit_runs", 9), ("n_jobs", 0),
     ("cv_folds", 1), ("switch_ratio", -0.1), ("family", "rbf"), ("sd_model", "linear"), ("error_tails", "cauchy"),
-    ("n_starts", "two"), ("fit_mean", [True]), ("n_start", 2),
+    ("n_starts", "two"), ("fit_mean", [True]), ("n_start", 2), ("n_starts", "2"), ("fit_mean", "yes"),
+    ("fit_mean", 1), ("switch_ratio", True), ("n_components", None),
 ])
 def test_both_doors_refuse_a_bad_emulator_setting_naming_it(paper_config, key, value):
     paper_config["emulator"][key] = value
@@ -93,3 +94,14 @@ def test_the_extractor_reads_its_shots_window_and_the_studys_mixture(paper_confi
     assert extractor_settings(config, "105S") == ExtractorSettings(window_after_arrival_us=0.9, n_samples=2000)
     assert extractor_settings(config, "104S").window_after_arrival_us == config["shots"]["104S"]["analysis"][
         "window_after_arrival_us"]
+
+
+@pytest.mark.parametrize("key, value", [("cfl", "0.5"), ("cell_size_um", True)])
+def test_a_hydro_setting_of_the_wrong_type_is_refused_by_both_doors(paper_config, key, value):
+    from shockcal.hydro import HydroSettings
+
+    paper_config["hydro"][key] = value
+    with pytest.raises(ConfigError, match=rf"^config\.yaml: hydro\.{key}: "):
+        validate_config(paper_config, source="config.yaml")
+    with pytest.raises(InputError, match=rf"^HydroSettings\.{key} .*: not a number$"):
+        HydroSettings(**{key: value})

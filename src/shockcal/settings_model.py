@@ -14,7 +14,8 @@ from __future__ import annotations
 from typing import Literal, get_args, get_origin
 
 import annotated_types
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic_core import PydanticCustomError
 
 from shockcal.errors import InputError, shown
 
@@ -46,13 +47,30 @@ class SettingsModel(BaseModel):
             super().__init__(**values)
         except ValidationError as exc:
             error = exc.errors()[0]
-            where = ".".join(str(part) for part in error["loc"])
-            value = "" if error["type"] == "missing" else f" {shown(error['input'])}"
+            where = error["loc"][0]      # a field (a union's member after it: n_components.int)
+            value = "" if error["type"] == "missing" else f" {_shown(error['input'])}"
             raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}") from None
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _config_types(cls, value, info):
+        """The config's types (JSON Schema's): a flag is true or false, a number is no text and no flag (pydantic
+        alone would read "2" as 2, "yes" as true and true as 1, which the config refuses)."""
+        annotation = cls.model_fields[info.field_name].annotation
+        if annotation is bool and not isinstance(value, bool):
+            raise PydanticCustomError("config_type", "not true or false")
+        if annotation in (int, float, int | float) and isinstance(value, bool | str):
+            raise PydanticCustomError("config_type", "not a number")
+        return value
 
     def replace(self, **changes):
         """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
         return type(self)(**{**self.model_dump(), **changes})
+
+
+def _shown(value) -> str:
+    """A value as the config writes it: true, null, 0.5, 'text'."""
+    return "null" if value is None else str(value).lower() if isinstance(value, bool) else shown(value)
 
 
 def schema_extras(model: type[SettingsModel]) -> dict[str, dict]:
