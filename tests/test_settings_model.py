@@ -44,6 +44,14 @@ def test_a_setting_the_config_accepts_reaches_the_library_by_name(paper_config, 
     assert all(getattr(settings, name) == config["emulator"][name] for name in section_fields(EmulatorSettings))
 
 
+def test_an_unknown_setting_gets_the_closest_name_through_both_doors(paper_config):
+    paper_config["emulator"]["n_start"] = 2
+    with pytest.raises(ConfigError, match="did you mean 'n_starts'"):
+        validate_config(paper_config)
+    with pytest.raises(InputError, match=r"^EmulatorSettings\.n_start 2: .*; did you mean 'n_starts'\?$"):
+        EmulatorSettings(n_start=2)
+
+
 def test_the_settings_are_frozen_and_a_changed_copy_is_checked():
     settings = EmulatorSettings(n_starts=3)
     with pytest.raises(ValueError):

@@ -4,13 +4,15 @@ entries for the section (`schema_properties`).
 
 A field's choices are its type (`Literal["a", "b"]`: the schema's `enum`), its limits pydantic's `ge`, `gt`,
 `le`, `lt` (the schema's `minimum`, `exclusiveMinimum`, `maximum`, `exclusiveMaximum`), so the config and
-the library refuse the same values. A bad value is one InputError line naming the class and the field,
-never a pydantic traceback. It sits beside `shockcal.errors` on the ground floor: the hydrocode's settings
-(`shockcal.hydro.settings_model` adds its physical rules) and the emulator's build on it.
+the library refuse the same values. A bad value is one InputError line naming the class and the field (an
+unknown one with the closest field, as the config's "did you mean"), never a pydantic traceback. It sits
+beside `shockcal.errors` on the ground floor: the hydrocode's settings (`shockcal.hydro.settings_model` adds
+its physical rules), the emulator's and the extractor's build on it.
 """
 
 from __future__ import annotations
 
+import difflib
 from typing import Literal, get_args, get_origin
 
 import annotated_types
@@ -49,7 +51,9 @@ class SettingsModel(BaseModel):
             error = exc.errors()[0]
             where = error["loc"][0]      # a field (a union's member after it: n_components.int)
             value = "" if error["type"] == "missing" else f" {_shown(error['input'])}"
-            raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}") from None
+            close = difflib.get_close_matches(str(where), list(type(self).model_fields), n=1)
+            hint = f"; did you mean '{close[0]}'?" if error["type"] == "extra_forbidden" and close else ""
+            raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}{hint}") from None
 
     @field_validator("*", mode="before")
     @classmethod
