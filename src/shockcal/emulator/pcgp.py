@@ -53,7 +53,8 @@ class Switch:
     affected: list[int]
 
 
-def _fit_hyper(x, w, fit_rows, settings: EmulatorSettings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
+def _fit_hyper(x, w, fit_rows, settings: EmulatorSettings, seed: int | np.random.SeedSequence,
+               start: Hyper | None) -> Hyper:
     """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,

@@ -28,7 +28,8 @@ from shockcal.design.tables import ShotMapping
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.held_out import Z90
 from shockcal.emulator.input_map import InputMap, joint_input_map, shot_input_map
-from shockcal.emulator.pcgp import FORMAT_VERSION, EmulatorSettings, PCGPEmulator, Switch
+from shockcal.emulator.pcgp import FORMAT_VERSION, PCGPEmulator, Switch
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.emulator.yield_input import YieldInput
 from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path

@@ -85,13 +85,11 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
 
 def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
     """`shots.<shot>.analysis` and `features`."""
-
     return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
 
 
 def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
     """A next-shot candidate's analysis window (`candidate_config`) and `features`."""
-
     return ExtractorSettings(**candidate_config(config, name)["analysis"], **config["features"])
 
 
