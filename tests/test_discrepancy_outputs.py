@@ -4,6 +4,8 @@ the InferenceData (dimensionless, described, and the sd they imply in m/s), the 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -18,17 +20,19 @@ from shockcal.inference.posterior_files import companion_path, read_posterior, w
 from shockcal.inference.sampler import Posterior, WeightedDraws
 from shockcal.io import read_table_metadata
 from shockcal.study.adapters import calibration_settings
+from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 az = pytest.importorskip("arviz")
-FEATURES = ["v_elastic", "v_plastic"]
-OBSERVED = pd.DataFrame([{"shot": "S1", "v_elastic": 118.0, "v_plastic": 87.2},
-                         {"shot": "S2", "v_elastic": 121.0, "v_plastic": 88.0}])
-DELTA = ["delta_sd_fraction_v_elastic", "delta_sd_fraction_v_plastic", "delta_rho_shots"]
+REPO = Path(__file__).resolve().parents[1]
+FEATURES = CALIBRATION_FEATURES          # v_elastic, v_plastic, v_slope1, v_slope2
+OBSERVED = pd.DataFrame([{"shot": "S1", "v_elastic": 118.0, "v_plastic": 87.2, "v_slope1": 120.0, "v_slope2": 86.0},
+                         {"shot": "S2", "v_elastic": 121.0, "v_plastic": 88.0, "v_slope1": 122.0, "v_slope2": 87.0}])
+DELTA = [f"delta_sd_fraction_{f}" for f in FEATURES] + ["delta_rho_shots"]
 
 
 def _mean(theta):
     a = theta[:, 0] ** 2
-    return np.column_stack([100 + 50 * a, 80 + 20 * a, 102 + 50 * a, 81 + 20 * a])
+    return np.column_stack([100 + 50 * a, 80 + 20 * a, 103 + 50 * a, 79 + 20 * a] * 2)
 
 
 def prior_importance_sample(problem, settings, other_powers="error"):
@@ -53,7 +57,7 @@ def posteriors(paper_config_readonly):
     config = copy.deepcopy(paper_config_readonly)
     config["inputs"]["A"] = {"min": -1, "max": 1, "unit": "Mbar"}
     config["calibration"].update(draws=600)
-    emulator = StandInEmulator(_mean, ["A"], [-1], [1], 0.01 * np.eye(4))
+    emulator = StandInEmulator(_mean, ["A"], [-1], [1], 0.01 * np.eye(8))
     emulator.feature_names = FEATURES
     runs = {}
     with pytest.MonkeyPatch.context() as patch:
@@ -119,6 +123,17 @@ def test_inference_data_names_describes_and_scales_the_discrepancy(posteriors):
     assert "delta_sd_v_plastic_m_s[S1]" in summary.index and summary.loc["delta_rho_shots", "mean"] > 0
 
 
+def test_posterior_netcdf_writes_the_discrepancy_from_calibrate_s_files(posteriors, tmp_path):
+    write_posterior(posteriors["with"], tmp_path / "joint.parquet")
+    out = tmp_path / "joint.nc"
+    assert main(["posterior-netcdf", "--config", str(REPO / "config" / "config.yaml"), "--posterior", str(tmp_path / "joint.parquet"),
+                 "--out", str(out)]) == 0
+    idata = az.from_netcdf(out)
+    assert [name for name in idata.posterior.data_vars if name.startswith("delta_")] == [
+        *DELTA, *(f"delta_sd_{f}_m_s" for f in FEATURES)]
+    assert idata.posterior.attrs["discrepancy_sd_fraction_prior"] == 0.02
+
+
 def test_inference_data_without_a_discrepancy_is_as_before(posteriors):
     idata = _inference_data(posteriors["none"])
     assert list(idata.posterior.data_vars) == ["A_MPa", "lambda_y"]
@@ -134,7 +149,7 @@ def test_implied_sd_is_the_fraction_times_the_measured_feature(posteriors):
     table = implied_sd_table(posterior.summary(), observed)
     assert list(zip(table["shot"], table["feature"])) == [("S1", f) for f in FEATURES] + [("S2", f) for f in FEATURES]
     summary = posterior.summary().set_index("parameter")
-    row = table.iloc[3]            # S2, v_plastic: 88.0 m/s
+    row = table.iloc[5]            # S2, v_plastic: 88.0 m/s
     assert row["observed_m_s"] == 88.0
     for q in ("q05", "q50", "q95"):
         assert row[f"fraction_{q}"] == summary.loc["delta_sd_fraction_v_plastic", q]
@@ -157,7 +172,7 @@ def test_report_tables_write_the_discrepancy_table_and_refuse_a_posterior_withou
     out = tmp_path / "report"
     assert main(["report-tables", "--discrepancy", f"joint={tmp_path / 'with.parquet'}", "--out-dir", str(out)]) == 0
     table = pd.read_csv(out / "discrepancy.csv")
-    assert list(table["calibration"].unique()) == ["joint"] and len(table) == 4
+    assert list(table["calibration"].unique()) == ["joint"] and len(table) == 8
     assert "sd_m_s_q50" in table and "<table" in (out / "discrepancy.html").read_text()
     capsys.readouterr()
     assert main(["report-tables", "--discrepancy", f"joint={tmp_path / 'none.parquet'}", "--out-dir", str(out)]) == 2
