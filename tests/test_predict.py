@@ -70,6 +70,24 @@ def test_cli_writes_the_design(paper_config, tmp_path, capsys):
     assert "--stream: unknown random stream 'nope'" in capsys.readouterr().err
 
 
+def test_cli_carries_the_discrepancy_s_columns_after_lambda_y(paper_config, tmp_path):
+    """A posterior with a discrepancy (its parameters in the draws) gives a design that carries them, for the
+    predictive coverage with and without it; the inputs and lambda_y are drawn as without one."""
+    posterior = tmp_path / "joint.parquet"
+    delta = ["delta_sd_fraction_v_elastic", "delta_sd_fraction_v_plastic", "delta_sd_fraction_v_slope1",
+             "delta_sd_fraction_v_slope2", "delta_rho_shots"]
+    table = _posterior(paper_config, 200)
+    write_table(table.assign(**{name: np.linspace(0.0, 0.05, 200) + k for k, name in enumerate(delta)}), posterior)
+    out, plain = tmp_path / "design.parquet", tmp_path / "plain.parquet"
+    assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(out), "--n-runs", "20"]) == 0
+    design = read_table(out)
+    assert list(design.columns) == ["run", *input_names(paper_config), "lambda_y", *delta]
+    write_table(table, tmp_path / "none.parquet")
+    assert main(["predict", "--config", CONFIG, "--posterior", str(tmp_path / "none.parquet"), "--out", str(plain),
+                 "--n-runs", "20"]) == 0
+    pd.testing.assert_frame_equal(design.drop(columns=delta), read_table(plain))
+
+
 class _LinearEmulator:
     """Stands in for shockcal.emulator.study_emulator.Emulator: features = 1e4 * V of the shot, sd 2 m/s."""
 

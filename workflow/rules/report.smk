@@ -1,6 +1,9 @@
 # The report's tables (snakemake --report shows HTML inline; each table also as CSV beside it): posterior
 # summaries, evidence, cross-validation, the Sobol indices, the emulator on the posterior's predictive runs,
-# and the synthetic-truth coverage when `make check` has made it.
+# and the synthetic-truth coverage when `make check` has made it; with a model discrepancy, its sd in m/s and the
+# joint posterior's predictive coverage with it and without it.
+
+from shockcal.inference.discrepancy import enabled as discrepancy_enabled
 
 COVERAGE = existing_coverage(CHECK_TRUTHS, CHECK_TARGETS)
 
@@ -82,7 +85,45 @@ rule report_heldout:
         " --heldout-features {params.pairs} --out-dir {params.out_dir} > {log} 2>&1"
 
 
+rule report_discrepancy:
+    """The model discrepancy (calibration.discrepancy) in the report: its sd per calibration, shot and feature in
+    m/s, and the joint posterior's predictive 95% bands of the measured features with it and without it (at the
+    predict design's posterior draws, from the emulator: no hydrocode run). Thin: `shockcal report-tables`. In
+    `all` only for a study with a discrepancy (a posterior without one is refused by --discrepancy)."""
+    input:
+        posteriors=expand(rules.calibrate.output.samples, name=CALIBRATIONS),
+        summaries=expand(rules.calibrate.output.summary, name=CALIBRATIONS),
+        design=PLAN.run_set_path("predict", "design.parquet"),
+        emulator=rules.emulator.output.emulator,
+        arrays=rules.emulator.output.arrays,
+    output:
+        discrepancy=report(
+            f"{RESULTS}/report/discrepancy.html", caption="../report/discrepancy.rst", category="4 posterior"
+        ),
+        predictive=report(
+            f"{RESULTS}/report/predictive_coverage.html",
+            caption="../report/predictive_coverage.rst",
+            category="4 posterior",
+        ),
+        csv=[f"{RESULTS}/report/{name}.csv" for name in ("discrepancy", "predictive_coverage")],
+    log:
+        f"{LOGS}/report_discrepancy.log",
+    conda:
+        "../envs/shockcal.yaml"
+    params:
+        posteriors=lambda w, input: pairs(CALIBRATIONS, input.posteriors),
+        joint=lambda w, input: input.posteriors[CALIBRATIONS.index("joint")],
+        emulator_dir=lambda w, input: os.path.dirname(input.emulator),
+        out_dir=lambda w, output: os.path.dirname(output.discrepancy),
+    shell:
+        "shockcal report-tables --discrepancy {params.posteriors} --predictive-posterior {params.joint}"
+        " --predictive-design {input.design} --predictive-emulator {params.emulator_dir}"
+        " --out-dir {params.out_dir} > {log} 2>&1"
+
+
 ALL_TARGETS.extend(rules.report_tables.output)
+if discrepancy_enabled(config["calibration"].get("discrepancy")):
+    ALL_TARGETS.extend(rules.report_discrepancy.output)
 if not PLAN.archive:  # an archive study runs no predictive runs
     ALL_TARGETS.extend(rules.report_heldout.output)
 # the coverage checks are outside `all` (make check); their table joins the report once one exists

@@ -117,7 +117,24 @@ def run(args) -> int:
         "log evidence %.3f +- %.3f):\n%s", "+".join(args.shots), info["ess_kish"], len(posterior.draws),
         info["distinct_draws"], info["likelihood_evaluations"], info["log_evidence"], info["log_evidence_sd"],
         posterior.summary().to_string(index=False, float_format="%.4g"))
+    if "discrepancy_parameters" in info:
+        log_discrepancy(posterior, list(emulator.feature_names))
     return 0
+
+
+def log_discrepancy(posterior, features: list[str]) -> None:
+    """Log the discrepancy's sd per shot and feature in m/s at its posterior 5/50/95% points."""
+    import logging
+
+    from shockcal.inference.discrepancy import implied_sd_table
+    from shockcal.inference.inference_data import observed_frames
+
+    info = posterior.info()
+    observed, _ = observed_frames(info["shots"], info["observed"], info["observed_sd_m_s"], features)
+    logging.getLogger("shockcal.calibrate").info(
+        "model discrepancy's sd (m/s) per shot and feature at its 5/50/95%% points (the sd fraction times the "
+        "measured feature):\n%s", implied_sd_table(posterior.summary(), observed).to_string(index=False,
+                                                                                           float_format="%.4g"))
 
 
 def run_check(args) -> int:

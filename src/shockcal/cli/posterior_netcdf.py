@@ -67,7 +67,8 @@ def run(args) -> int:
              "posterior_file": str(args.posterior), "shots": meta["shots"],
              **{key: meta[key] for key in ("sampler", "n_live", "n_eff_target", "seed", "cube_power",
                                            "log_evidence", "log_evidence_sd", "likelihood_evaluations",
-                                           "ess_kish", "weighted_draws", "retained", "distinct_draws") if key in meta}}
+                                           "ess_kish", "weighted_draws", "retained", "distinct_draws",
+                                           "discrepancy_sd_fraction_prior") if key in meta}}
     user_units = meta.get("user_units") or input_user_units(config)
     idata = posterior_inference_data(
         draws, names, units=meta["units"], user_units=user_units, lower={k: b[0] for k, b in bounds.items()},

@@ -39,6 +39,7 @@ def run(args) -> int:
 
     from shockcal.design.posterior_draws import draw_posterior_design
     from shockcal.errors import InputError
+    from shockcal.inference.discrepancy import is_discrepancy_parameter
     from shockcal.inference.problem import LAMBDA_Y
     from shockcal.io import read_table, read_table_metadata, write_table
     from shockcal.seeds import stream_seed
@@ -56,8 +57,9 @@ def run(args) -> int:
     if shots is not None and sorted(shots) != sorted(config["shots"]):
         raise InputError(f"{args.posterior}: a posterior of shots {shots}; predict draws from the joint posterior of the "
                          f"config's shots {sorted(config['shots'])}")
+    discrepancy = tuple(name for name in posterior.columns if is_discrepancy_parameter(name))   # none: ()
     design = draw_posterior_design(posterior, input_names(config), n_runs, seed, source=args.posterior,
-                                   bounds=prior_bounds(config), carried=(LAMBDA_Y,))
+                                   bounds=prior_bounds(config), carried=(LAMBDA_Y, *discrepancy))
     units = {name: config["inputs"].get(name, {"unit": "-"})["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "source": f"posterior draws from {args.posterior}, seed {seed}",
                                    "units": units})

@@ -9,8 +9,12 @@ checks' merged tables (`make check`), `coverage.csv` (per truth and parameter); 
 (`shockcal sensitivity`), `sobol.html` only (its CSV is the sensitivity stage's); from the emulator and
 hydrocode runs it never saw (the posterior's predictive runs), `emulator_heldout.csv` (RMSE and the share
 inside each feature's 90% band, then the share of runs inside its error model's 90% region of the feature
-vector: `shockcal.emulator.score_heldout`, `region_coverage`). Each table is written only when its inputs
-are given. No config is read.
+vector: `shockcal.emulator.score_heldout`, `region_coverage`); from the posteriors with a model discrepancy
+(`calibration.discrepancy`), `discrepancy.csv` (its sd per calibration, shot and feature in m/s at its
+5/50/95% points: `shockcal.inference.discrepancy.implied_sd_table`); from the joint posterior, the design of its
+predictive draws and the emulator, `predictive_coverage.csv` (each measured feature's place in its posterior
+predictive, 95% band with the discrepancy and without it: `shockcal.inference.predictive_coverage`). Each table
+is written only when its inputs are given. No config is read.
 """
 
 from __future__ import annotations
@@ -37,6 +41,14 @@ def register(subparsers) -> None:
                                             "posterior's predictive runs, results/predict/design.parquet)")
     p.add_argument("--heldout-features", nargs="+", default=[], metavar="SHOT=TABLE",
                    help="those runs' features per shot (shockcal features --out)")
+    p.add_argument("--discrepancy", nargs="+", default=[], metavar="NAME=POSTERIOR",
+                   help="posteriors with a model discrepancy (shockcal calibrate --out): its sd in m/s per shot and "
+                        "feature")
+    p.add_argument("--predictive-posterior", help="the joint posterior (shockcal calibrate --out): measured features, "
+                                                  "their sd, shots")
+    p.add_argument("--predictive-design", help="its predictive draws (shockcal predict --out), with lambda_y and the "
+                                               "discrepancy's columns")
+    p.add_argument("--predictive-emulator", help="the study's emulator directory, predicting at those draws")
     p.add_argument("--out-dir", required=True, help="folder for the tables (NAME.csv and NAME.html)")
     p.set_defaults(func=run)
 
@@ -103,6 +115,14 @@ def run(args) -> int:
         written += _write(heldout_table(args), out, "emulator_heldout",
                           "The emulator on hydrocode runs no fit saw (m/s): 90% band per feature, 90% region per "
                           "feature vector")
+    discrepancy = parse_pairs(args.discrepancy, "--discrepancy")
+    if discrepancy:
+        written += _write(discrepancy_table(discrepancy), out, "discrepancy",
+                          "Model discrepancy's sd (m/s) per shot and feature at its 5/50/95% points")
+    if args.predictive_posterior or args.predictive_design or args.predictive_emulator:
+        written += _write(predictive_table(args), out, "predictive_coverage",
+                          "Posterior-predictive 95% bands of the measured features (m/s), with the model discrepancy "
+                          "and without it")
     logging.getLogger("shockcal.report").info("wrote %s in %s", ", ".join(written) or "nothing", out)
     return 0
 
@@ -127,3 +147,47 @@ def heldout_table(args):
                                             zip(regions["block"], regions["n_features"])],
                                 "coverage": regions["coverage"], "n_values": regions["n_runs"]})
     return pd.concat([score_heldout(emulator, design, features), region_rows], ignore_index=True)
+
+
+def discrepancy_table(posteriors: dict):
+    """`implied_sd_table` of each posterior (name -> path), one block per calibration; a posterior without
+    a discrepancy is an InputError naming it."""
+    import pandas as pd
+
+    from shockcal.errors import InputError
+    from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, implied_sd_table
+    from shockcal.inference.inference_data import observed_frames
+    from shockcal.inference.posterior_files import companion_path
+    from shockcal.io import read_table, read_table_metadata
+
+    tables = []
+    for name, path in posteriors.items():
+        meta = read_table_metadata(path)
+        if "discrepancy_parameters" not in meta:
+            raise InputError(f"--discrepancy {name}={path}: a posterior without a model discrepancy "
+                             "(calibration.discrepancy: none)")
+        features = [p.removeprefix(SD_FRACTION_PREFIX) for p in meta["discrepancy_parameters"]
+                    if p.startswith(SD_FRACTION_PREFIX)]          # one per feature kind, in the emulator's order
+        observed, _ = observed_frames(meta["shots"], meta["observed"], meta["observed_sd_m_s"], features)
+        tables.append(implied_sd_table(read_table(companion_path(path)), observed).assign(calibration=name))
+    table = pd.concat(tables, ignore_index=True)
+    return table[["calibration", *[c for c in table.columns if c != "calibration"]]]
+
+
+def predictive_table(args):
+    """`study_predictive_coverage` of --predictive-posterior's measured features at --predictive-design's draws."""
+    from shockcal.emulator import Emulator
+    from shockcal.errors import InputError
+    from shockcal.inference.predictive_coverage import study_predictive_coverage
+    from shockcal.io import read_table, read_table_metadata
+
+    if not (args.predictive_posterior and args.predictive_design and args.predictive_emulator):
+        raise InputError("report-tables: --predictive-posterior, --predictive-design and --predictive-emulator go "
+                         "together")
+    meta = read_table_metadata(args.predictive_posterior)
+    missing = [key for key in ("shots", "observed", "observed_sd_m_s") if key not in meta]
+    if missing:
+        raise InputError(f"{args.predictive_posterior}: not a posterior written by `shockcal calibrate` (metadata "
+                         f"{missing} missing)")
+    return study_predictive_coverage(Emulator.load(args.predictive_emulator), read_table(args.predictive_design),
+                                     meta["shots"], meta["observed"], meta["observed_sd_m_s"], args.predictive_design)

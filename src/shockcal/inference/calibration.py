@@ -90,4 +90,7 @@ def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSett
     posterior.user_units = {k: settings.user_units.get(k, unit) for k, unit in units.items()}
     posterior.context.update(shots=list(shots), parameters=problem.names, units=units, user_units=posterior.user_units,
                              observed=problem.observed.tolist(), observed_sd_m_s=problem.obs_sd.tolist())
+    if problem.discrepancy is not None:    # absent without one: the files of `discrepancy: none` are as before
+        posterior.context.update(discrepancy_parameters=problem.discrepancy_names,
+                                 discrepancy_sd_fraction_prior=problem.discrepancy.sd_fraction_prior)
     return posterior

@@ -17,12 +17,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from scipy import stats
 
 from shockcal.errors import InputError
 
 KINDS = ("none", "feature_kind")
 RHO_NAME = "delta_rho_shots"
+SD_FRACTION_PREFIX = "delta_sd_fraction_"
+SD_PREFIX = "delta_sd_"            # the implied sd in m/s: delta_sd_<feature>_m_s (`implied_sd_table`)
 
 
 @dataclass(frozen=True)
@@ -43,7 +46,7 @@ class Discrepancy:
     @property
     def names(self) -> list[str]:
         """The sampled parameters' names: one sd fraction per feature kind, then rho."""
-        return [f"delta_sd_fraction_{name}" for name in self.feature_names] + [RHO_NAME]
+        return [f"{SD_FRACTION_PREFIX}{name}" for name in self.feature_names] + [RHO_NAME]
 
     def prior_transform(self, u: np.ndarray) -> np.ndarray:
         """Unit cube (N, kinds + 1) -> (fractions half-normal(0, sd_fraction_prior), rho uniform [0, 1])."""
@@ -86,3 +89,54 @@ def from_setting(setting, feature_names, n_shots: int, source: str = "calibratio
     if isinstance(prior, bool) or not isinstance(prior, (int, float)):
         raise InputError(f"{source}.sd_fraction_prior = {prior!r} is not a number")
     return Discrepancy(tuple(feature_names), int(n_shots), float(prior))
+
+
+def enabled(setting) -> bool:
+    """Whether a `calibration.discrepancy` setting asks for a discrepancy (not none, absent or kind none)."""
+    if isinstance(setting, dict):
+        return setting.get("kind", "feature_kind") != "none"
+    return setting not in (None, "none")
+
+
+def is_discrepancy_parameter(name: str) -> bool:
+    """Whether a posterior's parameter `name` is one of a discrepancy's (an sd fraction or rho)."""
+    return name == RHO_NAME or name.startswith(SD_FRACTION_PREFIX)
+
+
+def describe(name: str) -> str:
+    """One line saying what a discrepancy parameter is, in user units (the InferenceData's `description`)."""
+    if name == RHO_NAME:
+        return ("model discrepancy: correlation (dimensionless, 0-1) between two shots' discrepancies of the same "
+                "feature kind; prior uniform on [0, 1]")
+    feature = name.removeprefix(SD_FRACTION_PREFIX)
+    return (f"model discrepancy: its sd on {feature} as a fraction (dimensionless) of each shot's measured {feature}; "
+            "prior half-normal with sd calibration.discrepancy.sd_fraction_prior; times the measured value: "
+            f"{SD_PREFIX}{feature}_m_s")
+
+
+def implied_sd_table(summary: pd.DataFrame, observed: pd.DataFrame) -> pd.DataFrame:
+    """The discrepancy's sd in m/s per shot and feature at its posterior 5/50/95% points: the sd fraction's
+    quantiles times the measured feature (a fraction of it, so the quantiles map exactly).
+
+    Args:
+        summary: a posterior summary (`Posterior.summary()`: `parameter`, `q05`, `q50`, `q95`); its
+            `delta_sd_fraction_<feature>` rows are read.
+        observed: measured features, m/s: one row per shot (index: shot), a column per feature.
+
+    Returns:
+        Rows (shot, feature): `observed_m_s`, `fraction_q05/q50/q95` (-), `sd_m_s_q05/q50/q95` (m/s);
+        no rows when the summary has no sd fraction (`calibration.discrepancy: none`).
+    """
+    fractions = summary.set_index("parameter")
+    rows = []
+    for shot, measured in observed.iterrows():
+        for feature, value in measured.items():
+            name = f"{SD_FRACTION_PREFIX}{feature}"
+            if name not in fractions.index:
+                continue
+            q = fractions.loc[name, ["q05", "q50", "q95"]].to_numpy(float)
+            rows.append({"shot": str(shot), "feature": feature, "observed_m_s": float(value),
+                         **{f"fraction_{k}": v for k, v in zip(("q05", "q50", "q95"), q)},
+                         **{f"sd_m_s_{k}": v * abs(value) for k, v in zip(("q05", "q50", "q95"), q)}})
+    return pd.DataFrame(rows, columns=["shot", "feature", "observed_m_s", "fraction_q05", "fraction_q50", "fraction_q95",
+                                       "sd_m_s_q05", "sd_m_s_q50", "sd_m_s_q95"])

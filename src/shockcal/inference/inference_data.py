@@ -4,7 +4,10 @@
 
 - `posterior`: the equal-weight draws, one chain: every calibrated input in the unit a user reads, that
   unit in its name and its `units` attribute (`A_MPa`, `B_MPa`, `G1_GPa`, `Delta2_GPa`, `V1_m_s`; C, n,
-  m dimensionless), and lambda_y; coordinate `row`: the draw's row in the Parquet table;
+  m dimensionless), and lambda_y; coordinate `row`: the draw's row in the Parquet table; with
+  `calibration.discrepancy`, its parameters (`delta_sd_fraction_<feature>`, `delta_rho_shots`:
+  dimensionless, a `description` attribute each) and the sd they imply per shot in m/s,
+  `delta_sd_<feature>_m_s` (chain, draw, shot): the fraction times the measured feature;
 - `sample_stats`: `log_likelihood` of each draw (constants included);
 - `observed_data`: the measured calibration features per shot (m/s), dims (`shot`,);
 - `constant_data`: their sd (`<feature>_sd`, m/s) and the prior box `prior_lower`, `prior_upper` per
@@ -46,6 +49,7 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
+from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, SD_PREFIX, describe, is_discrepancy_parameter
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.io import atomic_path
 from shockcal.units import user_columns
@@ -91,7 +95,8 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
 
     Args:
         draws: equal-weight draws: a column per name in `names` and `log_likelihood`.
-        names: the parameters: the calibrated inputs (native units), then lambda_y (-).
+        names: the parameters: the calibrated inputs (native units), then lambda_y (-) and the
+            discrepancy's parameters (-), if any (`shockcal.inference.discrepancy`; no prior box).
         units: unit of each name in `draws` (e.g. "Mbar", "cm/us", "-").
         user_units: unit of each name in the file, where it differs from `units` (e.g. {"A": "MPa",
             "G1": "GPa", "V1": "m/s"}; `shockcal.units.user_unit`); the variable is named with it
@@ -113,7 +118,7 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
     missing = [c for c in [*names, "log_likelihood"] if c not in draws.columns]
     if missing:
         raise InputError(f"posterior draws: columns {missing} missing (columns: {list(draws.columns)})")
-    inputs = [n for n in names if n != LAMBDA_Y]
+    inputs = [n for n in names if n != LAMBDA_Y and not is_discrepancy_parameter(n)]
     unboxed = [n for n in inputs if n not in lower or n not in upper]
     if unboxed:
         raise InputError(f"posterior draws: no prior box for inputs {unboxed}")
@@ -132,10 +137,15 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
         the user unit, in it."""
         shape = (1, -1) if dims[0] == "chain" else (-1,)
         return {columns[name][0]: (dims, table[name].to_numpy(float).reshape(shape) * columns[name][2],
-                                   {"units": columns[name][1]}) for name in names}
+                                   {"units": columns[name][1],
+                                    **({"description": describe(name)} if is_discrepancy_parameter(name) else {})})
+                for name in names}
 
-    posterior = xr.Dataset(variables(draws, ("chain", "draw")),
-                           coords={"chain": [0], "draw": np.arange(n), "row": (("draw",), order)}, attrs=attrs)
+    coords = {"chain": [0], "draw": np.arange(n), "row": (("draw",), order)}
+    implied = _implied_sd(draws, names, observed)
+    if implied:
+        coords["shot"] = shots
+    posterior = xr.Dataset({**variables(draws, ("chain", "draw")), **implied}, coords=coords, attrs=attrs)
     sample_stats = xr.Dataset({"log_likelihood": (("chain", "draw"), draws["log_likelihood"].to_numpy(float)[None, :])},
                               coords={"chain": [0], "draw": np.arange(n)})
     observed_data = xr.Dataset({f: (("shot",), observed[f].to_numpy(float), {"units": "m/s"}) for f in features},
@@ -161,6 +171,19 @@ def posterior_inference_data(draws: pd.DataFrame, names: list[str], *, units: Ma
             coords={"weighted_draw": np.arange(len(weighted))},
             attrs={"about": "the sampler's weighted draws (the exact result); log_weight normalised, logsumexp = 0"})
     return az.InferenceData(attrs=attrs, **groups)
+
+
+def _implied_sd(draws: pd.DataFrame, names: list[str], observed: pd.DataFrame) -> dict:
+    """The discrepancy's sd in m/s per draw and shot, `delta_sd_<feature>_m_s` (chain, draw, shot): each
+    sd fraction in `names` times the measured feature; {} without a discrepancy."""
+    implied = {}
+    for name in names:
+        feature = name.removeprefix(SD_FRACTION_PREFIX)
+        if name.startswith(SD_FRACTION_PREFIX) and feature in observed.columns:
+            values = draws[name].to_numpy(float)[None, :, None] * np.abs(observed[feature].to_numpy(float))[None, None, :]
+            implied[f"{SD_PREFIX}{feature}_m_s"] = (("chain", "draw", "shot"), values, {
+                "units": "m/s", "description": f"model discrepancy's sd on {feature}: {name} times the measured {feature}"})
+    return implied
 
 
 def _predictive(predictive: Mapping[str, pd.DataFrame], shots: list[str], features: list[str]):

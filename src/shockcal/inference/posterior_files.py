@@ -4,7 +4,8 @@
 metadata (shots, parameters, `units` and `user_units`, measured features, sampler settings, evidence):
 
 - OUT: the equal-weight draws (`Posterior.draws`), the inputs in their native units (`units`, the
-  design's: the paper's Mbar and cm/us for Johnson-Cook);
+  design's: the paper's Mbar and cm/us for Johnson-Cook), lambda_y and, with `calibration.discrepancy`,
+  its parameters (named in the metadata's `discrepancy_parameters`, dimensionless);
 - OUT_summary.parquet: `Posterior.summary()`, in the units a user reads (MPa, GPa, m/s; the unit in
   each parameter's name);
 - OUT_weighted.parquet: the sampler's weighted draws (`Posterior.weighted_table()`, native units).
@@ -64,7 +65,7 @@ def read_posterior(path) -> Posterior:
     missing = [key for key in NEEDED_METADATA if key not in meta]
     if missing:
         raise InputError(f"{path}: not a posterior written by `shockcal calibrate` (metadata {missing} missing)")
-    names = [*meta["parameters"], LAMBDA_Y]
+    names = [*meta["parameters"], LAMBDA_Y, *meta.get("discrepancy_parameters", [])]
     weighted_path = companion_path(path, "weighted")
     if not weighted_path.is_file():
         raise InputError(f"{weighted_path}: missing; the weighted draws of {path} are written beside it by "
@@ -81,8 +82,8 @@ def read_posterior(path) -> Posterior:
                              table["replicate"].to_numpy() if "replicate" in table.columns else None)
     settings = SamplerSettings(n_live=meta["n_live"], n_eff=meta["n_eff_target"], draws=len(draws), seed=meta["seed"],
                                cube_power=meta["cube_power"], replicates=meta.get("replicates", 1))
-    context = {key: meta[key] for key in ("shots", "parameters", "units", "user_units", "observed", "observed_sd_m_s")
-               if key in meta}
+    context = {key: meta[key] for key in ("shots", "parameters", "units", "user_units", "observed", "observed_sd_m_s",
+                                          "discrepancy_parameters", "discrepancy_sd_fraction_prior") if key in meta}
     return Posterior(names, weighted, draws[[*names, "log_likelihood"]], settings, dict(meta["cube_power"]),
                      int(meta["distinct_draws"]), units=dict(meta["units"]), user_units=dict(meta.get("user_units") or {}),
                      context=context)

@@ -10,7 +10,8 @@ from __future__ import annotations
 from shockcal.errors import ConfigError
 
 # the report's tables with a caption (workflow/rules/report.smk), and the caption all history figures share
-REPORT_TABLES = ("posterior_summary", "evidence", "cross_validation", "sobol_table", "coverage", "emulator_heldout")
+REPORT_TABLES = ("posterior_summary", "evidence", "cross_validation", "sobol_table", "coverage", "emulator_heldout",
+                 "discrepancy", "predictive_coverage")
 HISTORY_CAPTION = "history"
 
 
