@@ -30,11 +30,10 @@ def child() -> None:
     from test_hydro import JC_FLOOR_CASES
     from test_hydro_laws import AL5083, LAW_FLOOR_CASES, THIN
 
+    import shockcal.hydro.plastic_return as patched
     from shockcal.hydro import ShotParameters, run_shot
     from shockcal.study.adapters import hydro_inputs
     from shockcal.study.validate import load_config
-
-    import shockcal.hydro.plastic_return as patched
     assert "if False and" in Path(patched.__file__).read_text(), "the child must run on the patched copy"
     config = load_config(ROOT / "config" / "config.yaml")
     config["hydro"].update(cell_size_um=4.0, end_time_us=0.6)
