@@ -94,7 +94,7 @@ def time_prediction(emulator, inputs) -> None:
     """Mean and covariance of all 12 features at the 1000 design points, on 1 and 2 threads."""
     for threads in (1, 2):
         for block in emulator.blocks:
-            block.model.settings.n_jobs = threads
+            block.model.settings = block.model.settings.replace(n_jobs=threads)
         emulator.predict(inputs, SHOTS)
         start = time.perf_counter()
         emulator.predict(inputs, SHOTS)

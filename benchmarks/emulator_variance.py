@@ -133,7 +133,7 @@ def main(argv=None) -> int:
     for sd_model in args.sd_model:
         print(f"\nsd_model {sd_model} ({source}, joint, {config['emulator']['cv_folds']}-fold, outer margin {margin})")
         start = time.perf_counter()
-        emulator = fit_emulator(design, features, replace(spec, settings=replace(spec.settings, sd_model=sd_model)))
+        emulator = fit_emulator(design, features, replace(spec, settings=spec.settings.replace(sd_model=sd_model)))
         print(f"  fit + {config['emulator']['cv_folds']}-fold calibration: {time.perf_counter() - start:.1f} s ({load()})")
         block = emulator.blocks[0]
         model, names = block.model, block.input_map.names

@@ -95,7 +95,7 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
     """Per calibration feature: R^2 of a 10-fold GP prediction of ours - FLAG from the shot's inputs
     (with the emulator's input powers), and the scatter sd (m/s) it leaves."""
     from shockcal.emulator.input_map import shot_input_map
-    from shockcal.emulator.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator
     from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
     ok = ours[ours["status"] == "ok"].set_index("run")
@@ -106,7 +106,7 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
     for feature in CALIBRATION_FEATURES:
         diff = (ok[feature] - flag.loc[ok.index, feature]).to_numpy()
         gp = PCGPEmulator.fit(x, diff[:, None], input_map.lower, input_map.upper,
-                              Settings(n_starts=1, calibrate_sd=False, n_components=1, n_jobs=PROCESSES))
+                              EmulatorSettings(n_starts=1, calibrate_sd=False, n_components=1, n_jobs=PROCESSES))
         held = gp.cross_validate(10)
         mse = float(np.mean((held.mean[:, 0] - diff[held.rows]) ** 2))
         rows[feature] = {"r2": 1.0 - mse / float(diff.var()), "scatter_sd": np.sqrt(mse)}

@@ -116,8 +116,8 @@ SETTINGS = [
     ("shockcal.hydro:HydroSettings", ["hydro"], {}, True),
     ("shockcal.hydro:Geometry", ["shots.*", "hydro"], {}, False),
     ("shockcal.hydro:MaterialProperties", ["material", "material.eos"], {}, False),
-    ("shockcal.velocimetry.features:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
-    ("shockcal.emulator.pcgp:Settings", ["emulator"], {"seed": "study.seed"}, False),
+    ("shockcal.velocimetry.settings:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
+    ("shockcal.emulator.settings:EmulatorSettings", ["emulator"], {"seed": "study.seed"}, False),
     ("shockcal.emulator.yield_input:YieldInput", ["emulator.yield_input"], {}, False),
     ("shockcal.inference.sampler:SamplerSettings", ["calibration"], {}, False),
     ("shockcal.inference.calibration:CalibrationSettings", [],
@@ -187,17 +187,26 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
 @pytest.mark.parametrize("section", sorted(MODEL_SECTIONS))
 def test_a_settings_models_section_of_the_schema_is_generated_from_it(section):
     """One definition: each field of the section's model is a schema key with the model's default (unless the
-    section requires the key), description and rule, and the YAML file names none of them."""
-    from shockcal.study.config_files import SCHEMA_PATH, load_schema
+    section requires the key), description and rule, in its own section or the one it names (ExtractorSettings'
+    analysis window: `shots.*.analysis`), and the YAML file names none of them."""
+    from shockcal.settings_model import KEY, SECTION, other_sections, section_fields
+    from shockcal.study.config_files import SCHEMA_PATH, load_schema, section_schema
 
-    model, node = MODEL_SECTIONS[section], load_schema()["properties"][section]
-    written = yaml.safe_load(SCHEMA_PATH.read_text())["properties"][section]["properties"]
-    assert not set(model.model_fields) & set(written), f"{section}: a field of {model.__name__} also in the YAML"
+    schema, model = load_schema(), MODEL_SECTIONS[section]
+    for where in [section, *other_sections(model)]:
+        written = section_schema(yaml.safe_load(SCHEMA_PATH.read_text()), where)["properties"]
+        assert not set(model.model_fields) & set(written), f"{where}: a field of {model.__name__} also in the YAML"
     for name, field in model.model_fields.items():
+        extra = field.json_schema_extra or {}
+        node = section_schema(schema, extra.get(SECTION, section))
+        if extra.get(KEY):       # e.g. the emulator's seed, study.seed: a key of the schema, not of this section
+            assert name not in section_fields(model) and name not in node["properties"]
+            assert "default" in _schema_node(schema, extra[KEY])
+            continue
         key = node["properties"][name]
         assert key["description"] == field.description and field.description
-        assert key.get("x-rule") == (field.json_schema_extra or {}).get("x-rule")
-        assert key.get("x-unit") == (field.json_schema_extra or {}).get("x-unit")
+        assert key.get("x-rule") == extra.get("x-rule")
+        assert key.get("x-unit") == extra.get("x-unit")
         if name in node.get("required", []):
             assert "default" not in key
         else:

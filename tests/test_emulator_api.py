@@ -7,7 +7,7 @@ import pytest
 
 from shockcal.emulator.correlation import FAMILIES, family_code, value_and_slope
 from shockcal.emulator.gp import GaussianProcess
-from shockcal.emulator.pcgp import PCGPEmulator, Settings, Switch
+from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator, Switch
 from shockcal.study.adapters import emulator_spec
 
 NOISE = 0.05
@@ -86,7 +86,7 @@ def _problem(n=60, seed=6):
 @pytest.mark.parametrize("warm_start", [True, False])
 def test_kfold_equals_brute_force_refits(warm_start):
     X, Y, lower, upper = _problem(n=24)
-    settings = Settings(family="matern52", n_starts=1, seed=3, calibrate_sd=False, cv_warm_start=warm_start, n_jobs=1)
+    settings = EmulatorSettings(family="matern52", n_starts=1, seed=3, calibrate_sd=False, cv_warm_start=warm_start, n_jobs=1)
     emulator = PCGPEmulator.fit(X, Y, lower, upper, settings)
     cv = emulator.cross_validate(4, seed=1)
     assert sorted(cv.rows) == list(range(24))
@@ -102,8 +102,8 @@ def test_kfold_equals_brute_force_refits(warm_start):
 
 def test_sd_calibration_is_one_factor_per_feature_from_the_kfold():
     X, Y, lower, upper = _problem(n=40)
-    raw = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=5, calibrate_sd=False, n_jobs=1))
-    calibrated = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=5, sd_model="constant", n_jobs=1))
+    raw = PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(n_starts=1, cv_folds=5, calibrate_sd=False, n_jobs=1))
+    calibrated = PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(n_starts=1, cv_folds=5, sd_model="constant", n_jobs=1))
     held = raw.cross_validate(5)
     z = np.abs(held.mean - Y[held.rows]) / held.sd
     np.testing.assert_allclose(calibrated.sd_factor, np.tile(np.quantile(z, 0.9, axis=0) / 1.6449, (2, 1)))
@@ -122,7 +122,7 @@ def test_a_switch_gets_its_own_sd_factor_and_its_bands_hold():
     clean = np.column_stack([0.5 + 0.6 * X[:, 0] + 0.1 * X[:, 1], np.ones(300)])
     past = clean[:, 0] > 0.9
     Y = clean + np.column_stack([np.where(past, 0.05, 0.005) * rng.normal(size=300), 0.005 * rng.normal(size=300)])
-    settings = Settings(n_starts=1, cv_folds=5, seed=2, n_jobs=1, sd_model="constant")
+    settings = EmulatorSettings(n_starts=1, cv_folds=5, seed=2, n_jobs=1, sd_model="constant")
     switch = [Switch(0, 1, [0])]
     with_switch = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), settings, switches=switch)
     without = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), settings)
@@ -139,7 +139,7 @@ def test_a_switch_gets_its_own_sd_factor_and_its_bands_hold():
 
 def test_arrays_api_fits_predicts_saves_and_loads(tmp_path):
     X, Y, lower, upper = _problem(n=60)
-    emulator = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=4, n_jobs=1, sd_model="constant"))
+    emulator = PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(n_starts=1, cv_folds=4, n_jobs=1, sd_model="constant"))
     X_new, Y_new, _, _ = _problem(n=50, seed=7)
     mean, cov = emulator.predict(X_new)
     assert mean.shape == (50, 3) and cov.shape == (50, 3, 3)
@@ -190,7 +190,7 @@ def test_predict_emulator_writes_every_run_shot_and_feature(tmp_path, paper_conf
 def test_same_seed_gives_the_same_emulator_and_another_seed_another_fit_subset():
     # the fit subset (max_fit_runs < runs), the GP starts and the K-fold all come from settings.seed
     X, Y, lower, upper = _problem(n=40)
-    fit = lambda seed: PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=2, cv_folds=4, max_fit_runs=30,  # noqa: E731
+    fit = lambda seed: PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(n_starts=2, cv_folds=4, max_fit_runs=30,  # noqa: E731
                                                                      seed=seed, n_jobs=1, sd_model="constant"))
     a, b, c = fit(5), fit(5), fit(6)
     for name, value in a.to_arrays().items():
@@ -208,7 +208,7 @@ def test_prediction_solves_on_one_blas_thread_and_equals_each_components_own(mon
     from threadpoolctl import threadpool_info
 
     X, Y, lower, upper = _problem(n=60)
-    emulator = PCGPEmulator.fit(X, Y, lower, upper, Settings(n_starts=1, cv_folds=4, n_jobs=2, sd_model="constant"))
+    emulator = PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(n_starts=1, cv_folds=4, n_jobs=2, sd_model="constant"))
     x_new = emulator.scaled(_problem(n=250, seed=7)[0])
     expected = [gp.predict(x_new) for gp in emulator.gps]
     threads = []

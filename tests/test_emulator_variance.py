@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from shockcal.emulator.held_out import Z90
-from shockcal.emulator.pcgp import PCGPEmulator, Settings
+from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator
 from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
 
@@ -31,7 +31,7 @@ def growing_noise(seed=0):
 
 def fit(sd_model, seed=1):
     X, Y = growing_noise()
-    return PCGPEmulator.fit(X, Y, np.zeros(3), np.ones(3), Settings(n_starts=1, cv_folds=5, seed=seed, sd_model=sd_model, n_jobs=1))
+    return PCGPEmulator.fit(X, Y, np.zeros(3), np.ones(3), EmulatorSettings(n_starts=1, cv_folds=5, seed=seed, sd_model=sd_model, n_jobs=1))
 
 
 @pytest.fixture(scope="module")
@@ -111,4 +111,4 @@ def test_variance_model_recovers_a_known_log_variance():
 
 def test_unknown_sd_model_is_refused():
     with pytest.raises(InputError, match="sd_model 'linear'"):
-        Settings(sd_model="linear")
+        EmulatorSettings(sd_model="linear")

@@ -6,7 +6,7 @@ import pytest
 from scipy import integrate, linalg, special, stats
 
 from shockcal.emulator.error_model import ErrorModel
-from shockcal.emulator.pcgp import PCGPEmulator, Settings
+from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator
 from shockcal.inference.problem import Problem
 
 
@@ -141,12 +141,12 @@ def test_emulator_fits_the_error_model_to_its_kfold_and_keeps_it(tmp_path):
     rng = np.random.default_rng(4)
     X = rng.uniform(size=(120, 2))
     Y = np.column_stack([np.sin(3 * X[:, 0]) + X[:, 1], np.cos(2 * X[:, 1]) + X[:, 0] ** 2])
-    emu = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), Settings(n_starts=1, cv_folds=5, n_jobs=1, sd_model="constant"))
+    emu = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), EmulatorSettings(n_starts=1, cv_folds=5, n_jobs=1, sd_model="constant"))
     held = emu.cross_validate(5)
     assert held.cov is not None and len(held.rows) == 120
     assert emu.error == ErrorModel.fit(*held.distances(Y)) and np.isfinite(emu.error.dof)
     loaded = PCGPEmulator.load(emu.save(tmp_path / "emu.npz"))
     assert loaded.error == emu.error
-    gaussian = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), Settings(n_starts=1, cv_folds=5, error_tails="gaussian", n_jobs=1,
+    gaussian = PCGPEmulator.fit(X, Y, np.zeros(2), np.ones(2), EmulatorSettings(n_starts=1, cv_folds=5, error_tails="gaussian", n_jobs=1,
                                                                                 sd_model="constant"))
     assert gaussian.error == ErrorModel()

@@ -395,7 +395,7 @@ def _small_emulator(config, directory=None):
     """A real 104S-only study emulator (20 runs of smooth made-up features on the paper's box), saved
     to `directory` when given."""
     from shockcal.emulator.input_map import shot_input_map
-    from shockcal.emulator.pcgp import PCGPEmulator, Settings
+    from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator
     from shockcal.emulator.study_emulator import Block, Emulator
 
     bounds = prior_bounds(config)
@@ -405,7 +405,7 @@ def _small_emulator(config, directory=None):
     x = input_map.scaled(design)
     y = np.column_stack([60 + 20 * x[:, 0], 190 + 20 * x[:, 5], 80 + 10 * x[:, 1], 180 + 15 * x[:, 5] - 5 * x[:, 3]])
     model = PCGPEmulator.fit(input_map.raw(design), y, input_map.lower, input_map.upper,
-                             Settings(n_starts=1, cv_folds=3, calibrate_sd=False, n_jobs=1))
+                             EmulatorSettings(n_starts=1, cv_folds=3, calibrate_sd=False, n_jobs=1))
     emulator = Emulator("per_shot", [Block(input_map, ["104S"], design["run"].to_numpy(), model)], dict(bounds),
                         {"104S": mapping.inputs()})
     if directory is not None:

@@ -100,7 +100,7 @@ def test_the_yield_input_lets_the_emulator_see_a_switch_in_the_yield(paper_confi
     spec = emulator_spec(config, SHOTS)
     # no K-fold sd calibration nor error tails: they scale the predictive sd, not the mean this test scores and
     # reloads (the means measured identical bit for bit with them, 2026-11-29), and were two thirds of its time
-    spec = replace(spec, settings=replace(spec.settings, n_starts=1, calibrate_sd=False, error_tails="gaussian"))
+    spec = replace(spec, settings=spec.settings.replace(n_starts=1, calibrate_sd=False, error_tails="gaussian"))
     design, _ = study_design(config, n_runs=180)
     train, test = design.iloc[:120], design.iloc[120:]
     features = _switching_features(design, spec.yield_input)

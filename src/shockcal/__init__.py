@@ -22,7 +22,7 @@ __version__ = "0.1.0"
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "PCGPEmulator": "shockcal.emulator.pcgp",
-    "EmulatorSettings": "shockcal.emulator.pcgp:Settings",
+    "EmulatorSettings": "shockcal.emulator.settings",
     "Problem": "shockcal.inference.problem",
     "SamplerSettings": "shockcal.inference.sampler",
     "sample": "shockcal.inference.sampler",

@@ -1,7 +1,7 @@
 """Emulator: the principal-component Gaussian-process emulator of the features.
 
 `gp` (one GP at its MAP hyperparameters) on the correlation kernels of `correlation`; `pcgp` (the
-array-level `PCGPEmulator` and its `Settings`: fit, predict, K-fold, save, load) with its error model
+array-level `PCGPEmulator` and its `EmulatorSettings`: fit, predict, K-fold, save, load) with its error model
 (`error_model`: Student t or Gaussian) and the error's variance over the box (`variance_model`);
 `study_emulator` maps a study's design columns and shots onto PC-GP blocks (`fit_emulator`,
 `Emulator`); `heldout` scores one on runs it was not fitted on, feature by feature (`score_heldout`) and as the
@@ -13,7 +13,7 @@ from shockcal._lazy import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "PCGPEmulator": "shockcal.emulator.pcgp",
-    "Settings": "shockcal.emulator.pcgp",
+    "EmulatorSettings": "shockcal.emulator.settings",
     "Emulator": "shockcal.emulator.study_emulator",
     "EmulatorSpec": "shockcal.emulator.study_emulator",
     "fit_emulator": "shockcal.emulator.study_emulator",

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-FAMILIES = ("gaussian", "matern52", "matern32")
+from shockcal.emulator.settings import FAMILIES
 
 
 def family_code(family: str) -> int:

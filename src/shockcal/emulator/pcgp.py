@@ -31,38 +31,15 @@ from threadpoolctl import ThreadpoolController, threadpool_limits
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.gp import GaussianProcess, Hyper
 from shockcal.emulator.held_out import HeldOut, blend_factors, cross_fitted, sd_calibration
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.emulator.variance_model import VarianceModel
 from shockcal.errors import InputError
 from shockcal.io import atomic_path
 
 FORMAT_VERSION = 5                  # 5: the smooth sd model (4 had constant sd factors only, 3 no error tails)
-SD_MODELS = ("constant", "smooth")
 SWITCH_WIDTH = 0.02                 # width of the logistic step between regimes, in the switch's ratio
 PREDICT_BATCH = 1000                # points per batch of a prediction (memory: components x batch x runs)
 log = logging.getLogger("shockcal.emulator.pcgp")
-
-
-@dataclass
-class Settings:
-    """How a PCGPEmulator is fitted (config `emulator`, or keyword arguments from a notebook)."""
-
-    family: str = "matern52"       # correlation family (correlation.FAMILIES)
-    fit_mean: bool = True          # per-component constant mean (GLS), else zero
-    n_components: float = 0.999    # integer count, or variance fraction in (0, 1)
-    n_starts: int = 2              # L-BFGS-B starts per GP
-    max_fit_runs: int = 500        # hyperparameters fitted on at most this many runs (seeded subset)
-    seed: int = 0
-    n_jobs: int = 2                # processes for the GP fits, threads for prediction (one BLAS thread each)
-    cv_folds: int = 10             # K-fold of the sd calibration
-    calibrate_sd: bool = True      # scale each feature's sd so that K-fold 90% bands hold 90%
-    cv_warm_start: bool = True     # refit each fold from the full fit's hyperparameters (one start)
-    switch_ratio: float = 0.9      # a Switch's ratio past which its own sd factors apply; 0: off
-    error_tails: str = "student_t"  # error model fitted to the K-fold: student_t (dof, scale) or gaussian
-    sd_model: str = "smooth"       # sd calibration: smooth over the box, or constant factors per output
-
-    def __post_init__(self):
-        if self.sd_model not in SD_MODELS:
-            raise InputError(f"emulator sd_model {self.sd_model!r}: one of {', '.join(SD_MODELS)}")
 
 
 @dataclass
@@ -76,7 +53,8 @@ class Switch:
     affected: list[int]
 
 
-def _fit_hyper(x, w, fit_rows, settings: Settings, seed: int | np.random.SeedSequence, start: Hyper | None) -> Hyper:
+def _fit_hyper(x, w, fit_rows, settings: EmulatorSettings, seed: int | np.random.SeedSequence,
+               start: Hyper | None) -> Hyper:
     """MAP hyperparameters of one basis weight's GP, on one BLAS thread."""
     with threadpool_limits(1):
         return GaussianProcess.fit(x, w, n_starts=settings.n_starts, seed=seed, fit_rows=fit_rows,
@@ -92,7 +70,7 @@ def _blas_threads() -> ThreadpoolController:
 class PCGPEmulator:
     """Principal-component GP emulator on plain arrays: inputs X (N, d) in a box, outputs Y (N, F).
 
-    >>> emu = PCGPEmulator.fit(X, Y, lower, upper, Settings(family="matern52"), input_names=["a", "b"])
+    >>> emu = PCGPEmulator.fit(X, Y, lower, upper, EmulatorSettings(family="matern52"), input_names=["a", "b"])
     >>> mean, cov = emu.predict(X_new)            # (M, F), (M, F, F)
     >>> cv = emu.cross_validate(10)               # refits everything per fold
 
@@ -101,7 +79,7 @@ class PCGPEmulator:
 
 
     def __init__(self, lower, upper, mean, scale, basis, residual_cov, x_train, y_train, hypers: list[Hyper],
-                 settings: Settings, sd_factor=None, switches=None, error: ErrorModel | None = None,
+                 settings: EmulatorSettings, sd_factor=None, switches=None, error: ErrorModel | None = None,
                  variance: VarianceModel | None = None, sd_groups=None):
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.mean, self.scale, self.basis = np.asarray(mean), np.asarray(scale), np.asarray(basis)
@@ -142,7 +120,7 @@ class PCGPEmulator:
                 f"error {self.error})")
 
     @classmethod
-    def fit(cls, X, Y, lower, upper, settings: Settings | None = None, starts: list[Hyper] | None = None,
+    def fit(cls, X, Y, lower, upper, settings: EmulatorSettings | None = None, starts: list[Hyper] | None = None,
             switches: list[Switch] | None = None, input_names: list[str] | None = None,
             sd_groups: list[list[int]] | None = None) -> PCGPEmulator:
         """Standardize Y, build the basis, fit one GP per basis weight at its posterior mode (from
@@ -152,7 +130,7 @@ class PCGPEmulator:
             X: training inputs (N, d), inside the box.
             Y: training outputs (N, F), e.g. features in m/s.
             lower, upper: the input box (d,), the inputs' prior box in a calibration.
-            settings: how the GPs are fitted (`Settings`; default its defaults).
+            settings: how the GPs are fitted (`EmulatorSettings`; default its defaults).
             starts: hyperparameter starts, one per component (e.g. a previous fit's).
             switches: output regime switches that get sd factors of their own (`Switch`).
             input_names: the d inputs' names (default x0, x1, ...).
@@ -171,7 +149,7 @@ class PCGPEmulator:
         With `settings.error_tails == "student_t"`, the error model's (dof, scale) are fitted to
         the Mahalanobis distances of the same K-fold's errors (`shockcal.emulator.error_model`).
         """
-        settings = settings or Settings()
+        settings = settings or EmulatorSettings()
         model = cls._fit_many(X, Y, lower, upper, settings, [np.arange(len(Y))], starts)[0]
         model.switches = list(switches or [])
         model._input_names = list(input_names) if input_names is not None else None
@@ -190,7 +168,7 @@ class PCGPEmulator:
         return model
 
     @classmethod
-    def _fit_many(cls, X, Y, lower, upper, settings: Settings, row_sets, starts=None) -> list[PCGPEmulator]:
+    def _fit_many(cls, X, Y, lower, upper, settings: EmulatorSettings, row_sets, starts=None) -> list[PCGPEmulator]:
         """One emulator per set of training rows, all GP fits in one (parallel) batch. `starts`:
         hyperparameters to start component j's fit from (a refit of the same data's subsets)."""
         X, Y = np.asarray(X, dtype=float), np.asarray(Y, dtype=float)
@@ -345,7 +323,7 @@ class PCGPEmulator:
         return {f"{prefix}{k}": v for k, v in arrays.items()}
 
     def to_json(self) -> dict:
-        return {"settings": asdict(self.settings), "switches": [asdict(sw) for sw in self.switches],
+        return {"settings": self.settings.model_dump(), "switches": [asdict(sw) for sw in self.switches],
                 "error": self.error.to_json(), "sd_groups": self.sd_groups,
                 "variance": None if self.variance is None else self.variance.to_json(),
                 "hyperparameters": [{"lambda_w": g.hyper.lambda_w, "beta": g.hyper.beta.tolist(),
@@ -355,7 +333,7 @@ class PCGPEmulator:
     def from_saved(cls, meta: dict, arrays, prefix: str = "") -> PCGPEmulator:
         hypers = [Hyper(h["lambda_w"], np.array(h["beta"]), h["lambda_n"], h["mean"]) for h in meta["hyperparameters"]]
         fields = ("lower", "upper", "mean", "scale", "basis", "residual_cov", "x_train", "y_train")
-        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, Settings(**meta["settings"]),
+        return cls(*(arrays[f"{prefix}{k}"] for k in fields), hypers, EmulatorSettings(**meta["settings"]),
                    arrays[f"{prefix}sd_factor"], [Switch(**sw) for sw in meta["switches"]],
                    ErrorModel.from_json(meta["error"]),
                    None if meta["variance"] is None else VarianceModel.from_saved(meta["variance"], arrays, prefix),

@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +28,8 @@ from shockcal.design.tables import ShotMapping
 from shockcal.emulator.error_model import ErrorModel
 from shockcal.emulator.held_out import Z90
 from shockcal.emulator.input_map import InputMap, joint_input_map, shot_input_map
-from shockcal.emulator.pcgp import FORMAT_VERSION, PCGPEmulator, Settings, Switch
+from shockcal.emulator.pcgp import FORMAT_VERSION, PCGPEmulator, Switch
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.emulator.yield_input import YieldInput
 from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path
@@ -53,7 +54,7 @@ class EmulatorSpec:
     shots: Mapping[str, ShotMapping]
     bounds: Mapping[str, tuple[float, float]]
     powers: tuple[tuple[float, str], ...] = ()
-    settings: Settings = field(default_factory=Settings)
+    settings: EmulatorSettings = field(default_factory=EmulatorSettings)
     own_blocks: tuple[str, ...] = ()
     yield_input: YieldInput | None = None
 
@@ -358,7 +359,7 @@ def fit_emulator(design: pd.DataFrame, features: dict[str, pd.DataFrame], spec: 
         _check_training_inputs(table, input_map, label)
         if spec.yield_input is not None:
             input_map = input_map.with_yield(spec.yield_input, table)
-        settings = replace(spec.settings, seed=stream_seed(spec.settings.seed, "emulator", i))
+        settings = spec.settings.replace(seed=stream_seed(spec.settings.seed, "emulator", i))
         model = PCGPEmulator.fit(input_map.raw(table), table[columns].to_numpy(), input_map.lower, input_map.upper,
                                  settings, switches=single_wave_switches(len(block_shots)),
                                  sd_groups=feature_groups(len(block_shots)))

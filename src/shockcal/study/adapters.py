@@ -2,21 +2,22 @@
 
 Each adapter takes a validated config (or the slice its stage reads, `shockcal.study.stages`) and
 returns what a library function takes; the library never sees a dict. Field names of the settings
-are the config's keys, so most adapters copy by name. The emulator's, the calibration's and the
-extractor's modules are imported by their adapters, so that a simulate job does not pay for them
-(0.7 s a job).
+are the config's keys, so most adapters copy by name. The emulator's and the calibration's modules are
+imported by their adapters, so that a simulate job does not pay for them (0.7 s a job); the settings
+models of the emulator and the extractor are light modules of their own.
 """
 
 from __future__ import annotations
 
-from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_hypercube, load_design
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.seeds import stream_seed
+from shockcal.settings_model import section_fields
 from shockcal.study.config import (
     AUTO_END_MARGIN_US,
     PER_RUN_RISE_FRACTION,
@@ -29,15 +30,14 @@ from shockcal.study.config import (
     wave_sizes,
 )
 from shockcal.study.strength_config import material_constants, strength_law, strength_parameters
+from shockcal.velocimetry.settings import ExtractorSettings
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from shockcal.campaign.candidates import Candidate
-    from shockcal.emulator.pcgp import Settings as EmulatorSettings
     from shockcal.emulator.study_emulator import EmulatorSpec
     from shockcal.inference.calibration import CalibrationSettings
-    from shockcal.velocimetry.features import ExtractorSettings
 
 
 def input_box(config: dict) -> InputBox:
@@ -85,15 +85,11 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
 
 def extractor_settings(config: dict, shot: str) -> ExtractorSettings:
     """`shots.<shot>.analysis` and `features`."""
-    from shockcal.velocimetry.features import ExtractorSettings
-
     return ExtractorSettings(**shot_config(config, shot)["analysis"], **config["features"])
 
 
 def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
     """A next-shot candidate's analysis window (`candidate_config`) and `features`."""
-    from shockcal.velocimetry.features import ExtractorSettings
-
     return ExtractorSettings(**candidate_config(config, name)["analysis"], **config["features"])
 
 
@@ -135,11 +131,8 @@ def candidate_box(config: dict, name: str) -> InputBox:
 
 def emulator_settings(config: dict) -> EmulatorSettings:
     """`emulator` (the GP settings by name), seeded by study.seed."""
-    from shockcal.emulator.pcgp import Settings as EmulatorSettings
-
-    section = config["emulator"]
-    names = {f.name for f in fields(EmulatorSettings)} - {"seed"}
-    return EmulatorSettings(seed=config["study"]["seed"], **{k: section[k] for k in names if k in section})
+    return EmulatorSettings(seed=config["study"]["seed"],
+                            **{name: config["emulator"][name] for name in section_fields(EmulatorSettings)})
 
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:

@@ -21,9 +21,11 @@ from pathlib import Path
 
 import yaml
 
+from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.settings import HydroSettings
-from shockcal.hydro.settings_model import schema_properties
+from shockcal.settings_model import other_sections, schema_properties
+from shockcal.velocimetry.settings import ExtractorSettings
 
 EXTENDS = "extends"
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -32,17 +34,41 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 
 
 # Config sections whose keys are a library settings model's fields: the schema's entries for them are
-# generated from the model (`shockcal.hydro.settings_model.schema_properties`), the YAML holds only the rest.
-MODEL_SECTIONS = {"hydro": HydroSettings}
+# generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest. A
+# field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there.
+MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "features": ExtractorSettings}
+AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
 @functools.lru_cache(maxsize=1)
 def _schema_text_parsed() -> dict:
     schema = yaml.load(SCHEMA_PATH.read_text(), Loader=YAML_LOADER)
-    for section, model in MODEL_SECTIONS.items():
-        entry = schema["properties"][section]
-        entry["properties"] = {**schema_properties(model, entry.get("required", [])), **entry["properties"]}
+    for own, model in MODEL_SECTIONS.items():
+        for section in [None, *other_sections(model)]:
+            entry = section_schema(schema, section or own)
+            generated = schema_properties(model, entry.get("required", []), section)
+            entry["properties"] = _placed(generated, entry["properties"])
     return schema
+
+
+def section_schema(schema: dict, section: str) -> dict:
+    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`)."""
+    entry = schema
+    for part in section.split("."):
+        entry = entry["additionalProperties"] if part == "*" else entry["properties"][part]
+    return entry
+
+
+def _placed(generated: dict, written: dict) -> dict:
+    """A model section's properties in their order: the model's fields, and each key the YAML writes after
+    the key its `x-after` names, else after the YAML key before it (the first one: first). The order is the
+    order a validated config holds the section's keys in, which the workflow's rerun triggers compare."""
+    keys, previous = list(generated), None
+    for name, entry in written.items():
+        after = entry.pop(AFTER, previous)
+        keys.insert(keys.index(after) + 1 if after is not None else 0, name)
+        previous = name
+    return {name: generated[name] if name in generated else written[name] for name in keys}
 
 
 def load_schema() -> dict:

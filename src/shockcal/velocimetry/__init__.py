@@ -10,7 +10,7 @@ features of the measured records with their read-out sd.
 from shockcal._lazy import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
-    "ExtractorSettings": "shockcal.velocimetry.features",
+    "ExtractorSettings": "shockcal.velocimetry.settings",
     "extract_features": "shockcal.velocimetry.features",
     "features_table": "shockcal.velocimetry.features",
     "record_features": "shockcal.velocimetry.features",

@@ -53,6 +53,8 @@ from scipy import optimize, stats
 from scipy.optimize import isotonic_regression
 from scipy.signal import savgol_filter
 
+from shockcal.velocimetry.settings import ExtractorSettings
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -73,6 +75,7 @@ RISE_SHARE = 0.15          # the slope points' read-out half-window at most this
 MIXTURE_STARTS = 3         # EM starts: quantile-spaced means, then k-means seeded 0, 1, ...
 MIXTURE_TOL = 1e-5         # EM stops when the mean log-likelihood gains less than this
 MIXTURE_MAX_ITER = 1000
+DEFAULT_SETTINGS = ExtractorSettings()     # the config's defaults (a frozen model: one for every call)
 
 
 class FeatureError(ValueError):
@@ -137,26 +140,7 @@ def detect_arrival(t: np.ndarray, v: np.ndarray) -> float:
     return float(t[np.argmax(v - baseline > threshold)])
 
 
-@dataclass(frozen=True)
-class ExtractorSettings:
-    """How one shot's traces are read; the defaults are the config schema's (a test keeps them equal).
-
-    Args:
-        window_after_arrival_us: end of the analysis window after the detected arrival (us; config
-            `shots.<shot>.analysis`); it must end before the release from the flyer's back arrives.
-        cutoff_after_arrival_us: the elastic cut-off after the arrival (us): components ending before
-            it form the early (elastic) mixture.
-        n_components: Gaussian mixture components (config `features`).
-        n_samples: stratified PIT samples of the trace's CDF (config `features`).
-    """
-
-    window_after_arrival_us: float = 1.2
-    cutoff_after_arrival_us: float = 0.04
-    n_components: int = 5
-    n_samples: int = 10000
-
-
-def extract(t, v, settings: ExtractorSettings = ExtractorSettings(), method: str = "exact",
+def extract(t, v, settings: ExtractorSettings = DEFAULT_SETTINGS, method: str = "exact",
             robust: bool | None = None) -> Extraction:
     """Run the extractor on one trace; raises FeatureError when it cannot.
 
@@ -376,6 +360,6 @@ def readout_replicates(t, v, settings: ExtractorSettings, replicates: int, seed:
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def extract_features(t, v, settings: ExtractorSettings = ExtractorSettings()) -> dict:
+def extract_features(t, v, settings: ExtractorSettings = DEFAULT_SETTINGS) -> dict:
     """The ten feature values of a trace (t in us, v in m/s)."""
     return extract(t, v, settings).features

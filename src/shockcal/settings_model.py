@@ -1,0 +1,115 @@
+"""The base of the library's settings that are also config sections: a frozen pydantic model whose fields
+carry their default, limits, unit and description once (`setting`), rendered into the config schema's
+entries for the section (`schema_properties`).
+
+A field's choices are its type (`Literal["a", "b"]`: the schema's `enum`), its limits pydantic's `ge`, `gt`,
+`le`, `lt` (the schema's `minimum`, `exclusiveMinimum`, `maximum`, `exclusiveMaximum`), so the config and
+the library refuse the same values. A bad value is one InputError line naming the class and the field (an
+unknown one with the closest field, as the config's "did you mean"), never a pydantic traceback. It sits
+beside `shockcal.errors` on the ground floor: the hydrocode's settings (`shockcal.hydro.settings_model` adds
+its physical rules), the emulator's and the extractor's build on it.
+"""
+
+from __future__ import annotations
+
+import difflib
+from typing import Literal, get_args, get_origin
+
+import annotated_types
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic_core import PydanticCustomError
+
+from shockcal.errors import InputError, shown
+
+KEY = "x-key"            # a field the config gives by a key of its own (e.g. `study.seed`), not generated
+SECTION = "x-section"    # a field that is a key of another config section than the model's own (generated there)
+TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", int | float: "number"}
+LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exclusiveMinimum"),
+          (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"))
+
+
+def setting(default, description: str, unit: str | None = None, key: str | None = None, section: str | None = None,
+            extra: dict | None = None, **limits):
+    """A settings field: its `default`, its `description` (the config page's text), its unit when its name
+    does not say it, the config `key` that gives it when no section of the model's holds it (e.g.
+    `study.seed`: not generated), the config `section` it is a key of when that is not the model's own
+    (dotted, `*` for every key of a mapping: `shots.*.analysis`; generated there), further schema keywords
+    `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt)."""
+    schema = {name: value for name, value in (("x-unit", unit), (KEY, key), (SECTION, section)) if value is not None}
+    return Field(default, description=description, json_schema_extra=(schema | (extra or {})) or None, **limits)
+
+
+class SettingsModel(BaseModel):
+    """Frozen, no unknown fields; a wrong type, choice or limit is one InputError line naming the field."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    def __init__(self, **values):
+        try:
+            super().__init__(**values)
+        except ValidationError as exc:
+            error = exc.errors()[0]
+            where = error["loc"][0]      # a field (a union's member after it: n_components.int)
+            value = "" if error["type"] == "missing" else f" {_shown(error['input'])}"
+            close = difflib.get_close_matches(str(where), list(type(self).model_fields), n=1)
+            hint = f"; did you mean '{close[0]}'?" if error["type"] == "extra_forbidden" and close else ""
+            raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}{hint}") from None
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _config_types(cls, value, info):
+        """The config's types (JSON Schema's): a flag is true or false, a number is no text and no flag (pydantic
+        alone would read "2" as 2, "yes" as true and true as 1, which the config refuses)."""
+        annotation = cls.model_fields[info.field_name].annotation
+        if annotation is bool and not isinstance(value, bool):
+            raise PydanticCustomError("config_type", "not true or false")
+        if annotation in (int, float, int | float) and isinstance(value, bool | str):
+            raise PydanticCustomError("config_type", "not a number")
+        return value
+
+    def replace(self, **changes):
+        """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
+        return type(self)(**{**self.model_dump(), **changes})
+
+
+def _shown(value) -> str:
+    """A value as the config writes it: true, null, 0.5, 'text'."""
+    return "null" if value is None else str(value).lower() if isinstance(value, bool) else shown(value)
+
+
+def schema_extras(model: type[SettingsModel]) -> dict[str, dict]:
+    """{field: its schema keywords given to `setting` (x-unit, x-key, extra)}."""
+    return {name: dict(field.json_schema_extra or {}) for name, field in model.model_fields.items()}
+
+
+def section_fields(model: type[SettingsModel], section: str | None = None) -> list[str]:
+    """The fields of `model` that are keys of config section `section` (`setting(section=...)`); None: of the
+    model's own section (the fields that name no other section and no key of their own)."""
+    return [name for name, extra in schema_extras(model).items() if KEY not in extra and extra.get(SECTION) == section]
+
+
+def other_sections(model: type[SettingsModel]) -> list[str]:
+    """The config sections besides its own that `model`'s fields are keys of (`setting(section=...)`)."""
+    return list(dict.fromkeys(extra[SECTION] for extra in schema_extras(model).values() if SECTION in extra))
+
+
+def schema_properties(model: type[SettingsModel], required: list[str] = (), section: str | None = None
+                      ) -> dict[str, dict]:
+    """The config schema's `properties` of `model`'s fields in config `section` (None: its own), in the
+    schema's own words (`type` or `enum`, the limits, the `x-` keywords but x-section, `default`,
+    `description`); a key the config section `required` gets no default."""
+    properties = {}
+    for name in section_fields(model, section):
+        field = model.model_fields[name]
+        if get_origin(field.annotation) is Literal:
+            entry = {"enum": list(get_args(field.annotation))}
+        else:
+            entry = {"type": TYPES[field.annotation]}
+        for limit in field.metadata:
+            entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+        entry |= {keyword: value for keyword, value in schema_extras(model)[name].items() if keyword != SECTION}
+        if name not in required:
+            entry["default"] = field.default
+        entry["description"] = field.description
+        properties[name] = entry
+    return properties
