@@ -133,11 +133,15 @@ def child(args) -> None:
 
 # ---------------------------------------------------------------------------------------------- parent: tables
 def run_tree(src: Path, argv: list[str], label: str) -> dict:
+    """The tree's rows (a child process on `src`), or those an earlier run kept when `src` is its .pkl file."""
+    if src.suffix == ".pkl":
+        print(f"{label}: {src} (kept from an earlier run)", flush=True)
+        return pd.read_pickle(src)
     out = Path(tempfile.mkdtemp(prefix=f"bench-rate-{label}-")) / "rows.pkl"
     env = dict(os.environ, PYTHONPATH=str(src))
     start = time.time()
     subprocess.run([sys.executable, __file__, "--child", "--out", str(out), *argv], env=env, check=True)
-    print(f"{label}: {src} done in {time.time() - start:.0f} s", flush=True)
+    print(f"{label}: {src} done in {time.time() - start:.0f} s (its rows: {out}, for --before)", flush=True)
     return pd.read_pickle(out)
 
 
@@ -194,7 +198,8 @@ def report(before: dict, after: dict, args) -> None:
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--before", type=Path, help="the source tree to compare with (its src/); required")
+    parser.add_argument("--before", type=Path, help="the source tree to compare with (its src/), or the rows.pkl an "
+                                                    "earlier run printed for it; required")
     parser.add_argument("--rows", type=int, default=30, help="design rows 0..N-1 (a, b, c, e)")
     parser.add_argument("--shots", nargs="+", default=["104S", "106S"])
     parser.add_argument("--inputs", nargs="+", default=["A", "B", "C", "n", "m", "V", "G1"],
