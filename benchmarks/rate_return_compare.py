@@ -9,7 +9,9 @@ subprocess of its own (PYTHONPATH), and prints side by side:
   a. rounding floor: each input the shot reads raised by one part in 1e12 (`--inputs`), per feature the
      median and max |change| (m/s; times in ns);
   b. time step: CFL 0.25 against the config's 0.5, the max |change| per feature and the max |change| of
-     the trace inside the analysis window (jump-off to `window_after_arrival_us` after it);
+     the trace inside the analysis window (jump-off to `window_after_arrival_us` after it), everywhere and
+     outside the fronts (where the base trace rises by less than FRONT_SLOPE: on a front a time shift of
+     0.1 ns reads as m/s);
   c. the Mbar and MPa doors: `ShotParameters.from_table_iv` against the same values in MPa, GPa, m/s;
   d. speed: one 104S run at the nominal design row, CPU seconds (best of 3) and the load average;
   e. mesh (`--mesh`): v_elastic and the four calibration features at 8 / 4 / 2 um;
@@ -41,6 +43,7 @@ PERTURBATION = 1e-12
 FEATURES = ["v_jumpoff", "v_elastic", "v_plastic", "v_slope1", "v_slope2", "t_jumpoff", "t_elastic", "t_plastic",
             "t_slope1", "t_slope2"]
 CALIBRATION = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]
+FRONT_SLOPE_M_S_PER_US = 1000.0    # 1 m/s per ns: steeper output samples belong to a front
 
 
 # ---------------------------------------------------------------------------------------------- child: one tree
@@ -53,11 +56,14 @@ def _features(result, settings):
 
 
 def _window_change(base, other, features, window_us):
-    """Max |v_other - v_base| (m/s) on the common output times inside [t_jumpoff, t_jumpoff + window]."""
+    """(max |v_other - v_base| (m/s) on the common output times inside [t_jumpoff, t_jumpoff + window], the
+    same outside the fronts: where |dv/dt| of the base trace is below FRONT_SLOPE_M_S_PER_US)."""
     n = min(len(base.t_us), len(other.t_us))
     t = base.t_us[:n]
     inside = (t >= features["t_jumpoff"]) & (t <= features["t_jumpoff"] + window_us)
-    return float(np.max(np.abs(other.v_m_s[:n] - base.v_m_s[:n])[inside]))
+    change = np.abs(other.v_m_s[:n] - base.v_m_s[:n])
+    flat = inside & (np.abs(np.gradient(base.v_m_s[:n], t)) < FRONT_SLOPE_M_S_PER_US)
+    return float(np.max(change[inside])), float(np.max(change[flat]))
 
 
 def child(args) -> None:
@@ -92,7 +98,8 @@ def child(args) -> None:
                 moved = dict(record, **{column: record[column] * (1.0 + PERTURBATION)})
                 add(shot, run, f"perturbed_{column}", run_shot(mapping.parameters(moved), *inputs), settings)
             halved = run_shot(params, inputs[0], inputs[1], inputs[2].replace(cfl=inputs[2].cfl / 2))
-            add(shot, run, "cfl_half", halved, settings, window_change=_window_change(base, halved, f, window))
+            everywhere, off_fronts = _window_change(base, halved, f, window)
+            add(shot, run, "cfl_half", halved, settings, window_change=everywhere, window_change_off_fronts=off_fronts)
             mpa = ShotParameters(params.A_MPa, params.B_MPa, params.C, params.n, params.m, params.velocity_m_s,
                                  params.shear_modulus_GPa)
             add(shot, run, "mpa_door", run_shot(mpa, *inputs), settings)
@@ -126,11 +133,15 @@ def child(args) -> None:
 
 # ---------------------------------------------------------------------------------------------- parent: tables
 def run_tree(src: Path, argv: list[str], label: str) -> dict:
+    """The tree's rows (a child process on `src`), or those an earlier run kept when `src` is its .pkl file."""
+    if src.suffix == ".pkl":
+        print(f"{label}: {src} (kept from an earlier run)", flush=True)
+        return pd.read_pickle(src)
     out = Path(tempfile.mkdtemp(prefix=f"bench-rate-{label}-")) / "rows.pkl"
     env = dict(os.environ, PYTHONPATH=str(src))
     start = time.time()
     subprocess.run([sys.executable, __file__, "--child", "--out", str(out), *argv], env=env, check=True)
-    print(f"{label}: {src} done in {time.time() - start:.0f} s", flush=True)
+    print(f"{label}: {src} done in {time.time() - start:.0f} s (its rows: {out}, for --before)", flush=True)
     return pd.read_pickle(out)
 
 
@@ -158,7 +169,8 @@ def report(before: dict, after: dict, args) -> None:
     print_side_by_side(f"a. rounding floor: |change| from a 1e-12 relative change of {', '.join(args.inputs)} "
                        f"({runs}; m/s, times ns)", stats(changes(b, "perturbed_")), stats(changes(a, "perturbed_")))
     cfl = lambda rows: pd.DataFrame({"max": pd.concat([changes(rows, "cfl_half")[FEATURES].max(),  # noqa: E731
-                                                       pd.Series({"trace in window": rows.window_change.max()})])})
+                                                       pd.Series({"trace in window": rows.window_change.max(),
+                                                                  "off the fronts": rows.window_change_off_fronts.max()})])})
     print_side_by_side(f"b. time step: CFL 0.25 against 0.5, max |change| ({runs}; m/s, times ns)", cfl(b), cfl(a))
     door = lambda rows: pd.DataFrame({"max": changes(rows, "mpa_door")[FEATURES].max()})  # noqa: E731
     print_side_by_side(f"c. MPa door against the Mbar door, max |change| ({runs}; m/s, times ns)", door(b), door(a))
@@ -186,7 +198,8 @@ def report(before: dict, after: dict, args) -> None:
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--before", type=Path, help="the source tree to compare with (its src/); required")
+    parser.add_argument("--before", type=Path, help="the source tree to compare with (its src/), or the rows.pkl an "
+                                                    "earlier run printed for it; required")
     parser.add_argument("--rows", type=int, default=30, help="design rows 0..N-1 (a, b, c, e)")
     parser.add_argument("--shots", nargs="+", default=["104S", "106S"])
     parser.add_argument("--inputs", nargs="+", default=["A", "B", "C", "n", "m", "V", "G1"],

@@ -29,10 +29,10 @@ FLYER_MM, TARGET_MM = 3.95, 5.965                 # shot 104S's plates
 
 
 def test_room_temperature_shot_is_the_code_before_bit_for_bit(paper_config):
-    """T0 = T_ref (given explicitly, left out, or through the config) reproduces the traces stored before the
-    initial temperature existed (tests/data/traces_before_flow_floors.npz; the code before and today's are two
-    paths: at the rounding floor, rtol 1e-10 of the peak), and the three ways to give T0 agree bit for bit."""
-    stored = np.load(DATA / "traces_before_flow_floors.npz")
+    """T0 = T_ref (given explicitly, left out, or through the config) reproduces the trace stored from the code
+    without its floor skips and without an initial temperature (tests/data/make_floor_free_traces.py; two paths:
+    at the rounding floor, rtol 1e-10 of the peak), and the three ways to give T0 agree bit for bit."""
+    stored = np.load(DATA / "traces_without_flow_floors.npz")
     assert AL5083.initial_state(298.0) == (AL5083.rho0_g_cc, 0.0)
     params = ShotParameters.from_table_iv(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27)
     paper_config["hydro"].update(cell_size_um=4.0, end_time_us=0.6)

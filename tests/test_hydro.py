@@ -10,14 +10,10 @@ import pytest
 from scipy.optimize import brentq
 
 from shockcal.hydro import ShotParameters, run_shot
-from shockcal.hydro.strength import (
-    flow_stress,
-    hardening,
-    radial_return,
-    rate_factor,
-    thermal_factor,
-    thermal_factor_below,
-)
+from shockcal.hydro.laws.johnson_cook import JohnsonCook
+from shockcal.hydro.plastic_return import initial_hardening, plastic_return
+from shockcal.hydro.state import LawStrength
+from shockcal.hydro.strength import hardening, rate_factor, thermal_factor, thermal_factor_below
 from shockcal.study.adapters import hydro_inputs
 
 DATA = Path(__file__).parent / "data"
@@ -158,10 +154,12 @@ def test_strength_conventions():
     assert thermal_factor(0.0, 0.1) == 0.0                                # m = 0 limit, T* > 0
     assert thermal_factor(0.0, 0.0) == 1.0
     assert thermal_factor(2.0, 0.5) == pytest.approx(0.75)
-    s, d_eps = radial_return(-0.004, 0.003, G)                            # 1.5 * 0.004 = 0.006 > 0.003
+    rate_free = LawStrength(JohnsonCook(0.003, 0.0, 0.0, 0.0, 1.0, 298.0, 893.0, 1e-6), G)   # Y = 0.003 Mbar
+    cell = (298.0, 1e-3, 0.0, 1.0, G, 0.0, initial_hardening(rate_free), 0.0, 0.0, math.inf, rate_free, None)
+    s, d_eps = plastic_return(-0.004, *cell)[:2]                          # 1.5 * 0.004 = 0.006 > 0.003
     assert 1.5 * abs(s) == pytest.approx(0.003) and s < 0
     assert d_eps == pytest.approx(0.003 / (3 * G))
-    assert radial_return(0.001, 0.003, G) == (0.001, 0.0)
+    assert plastic_return(0.001, *cell)[:2] == (0.001, 0.0)
 
 
 @pytest.mark.parametrize("path, value", [(("shots", "104S", "flyer_mm"), 0.0), (("shots", "105S", "target_mm"), -1.0),
@@ -178,27 +176,6 @@ def test_non_positive_geometry_is_a_config_error(paper_config, path, value):
         validate_config(paper_config)
 
 
-@pytest.mark.parametrize("C", [0.0, 0.0125, 0.03])
-@pytest.mark.parametrize("rate_per_s", [0.5, 1.4, 1.0e3, 2.0e6])
-def test_one_cell_at_constant_rate_flows_at_the_rate_term(C, rate_per_s):
-    """A cell strained at a constant total rate, composed as the solver does (elastic trial, Johnson-Cook
-    flow stress at the current total equivalent rate, radial return): once yielded it flows at exactly
-    A (1 + C ln((2/3) rate / eps0)), and at exactly A when (2/3) rate < 1 /s (the floored ratio)."""
-    A, strain_rate, eps0, steps = 0.003, rate_per_s * 1e-6, 1e-6, 4000    # Mbar, 1/us, 1/us
-    dt = 0.01 / (strain_rate * steps)                                     # 1% total strain: yields at about 0.56%
-    s, flows = 0.0, []
-    for _ in range(steps):
-        s_trial = s + 4.0 * G / 3.0 * strain_rate * dt
-        s, _ = radial_return(s_trial, flow_stress(A, 1.0, C, strain_rate, eps0), G)
-        flows.append(1.5 * abs(s))
-    ratio = (2.0 / 3.0) * rate_per_s
-    expected = A * (1.0 + C * math.log(ratio)) if ratio > 1.0 else A
-    assert flows[-1] == pytest.approx(expected, rel=1e-12)
-    assert flows[-2] == flows[-1]                                         # settled: no alternation
-    if ratio <= 1.0 or C == 0.0:
-        assert flows[-1] == A
-
-
 def test_c0_traces_identical_to_the_lagged_rate_code(paper_config):
     """C = 0 makes the rate convention irrelevant: traces stored before the rate change are reproduced (the
     code before and today's are two paths: at the rounding floor, rtol 1e-10 of the peak)."""
@@ -211,21 +188,26 @@ def test_c0_traces_identical_to_the_lagged_rate_code(paper_config):
         np.testing.assert_allclose(result.v_m_s, stored[name], rtol=1e-10, atol=1e-10 * np.max(np.abs(stored[name])), err_msg=name)
 
 
+# Johnson-Cook cases whose traces tests/data/make_floor_free_traces.py stores from the code without the floor
+# skips (rate term on, small m, n = 0, strong and hot cases): Table IV units, the 1.0 / 1.5 mm plates to 0.6 us.
+JC_FLOOR_CASES = {"gray_104": (0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),
+                  "soft_m_106": (0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30),
+                  "n0_105": (0.0072, 0.003, 0.0159, 0.0, 1.10, 0.03549, 0.28),
+                  "rate_hot_106": (0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),
+                  "strong_104": (0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
+
+
 def test_flow_stress_floors_change_no_trace(paper_config):
-    """The kernel skips the Johnson-Cook evaluation where a cell's trial stress lies inside a lower
-    bound of its flow stress (the flow-stress floors, 2026-11-24): traces stored from the code before
-    them (rate term on, small m, n = 0, strong and hot cases) are reproduced at the rounding floor (rtol 1e-10
-    of the peak: the code before and today's are two paths)."""
-    stored = np.load(DATA / "traces_before_flow_floors.npz")
-    cases = {"gray_104": ShotParameters.from_table_iv(0.0017, 0.00425, 0.0335, 0.42, 1.225, 0.0204, 0.27),
-             "soft_m_106": ShotParameters.from_table_iv(0.0032, 0.004, 0.0046, 0.69, 0.01, 0.04838, 0.30),
-             "n0_105": ShotParameters.from_table_iv(0.0072, 0.003, 0.0159, 0.0, 1.10, 0.03549, 0.28),
-             "rate_hot_106": ShotParameters.from_table_iv(0.0045, 0.008, 0.0248, 0.62, 2.47, 0.04838, 0.33),
-             "strong_104": ShotParameters.from_table_iv(0.0097, 0.002, 0.0267, 1.06, 2.85, 0.0204, 0.26)}
+    """The kernel skips the flow stress where a cell's trial stress lies inside a lower bound of it (the
+    flow-stress floors, 2026-11-24): traces stored from the same code with the floor skips removed
+    (tests/data/make_floor_free_traces.py, regenerated 2026-11-29 when the rate term moved inside the return)
+    are reproduced at the rounding floor (rtol 1e-10 of the peak: the two are two paths)."""
+    stored = np.load(DATA / "traces_without_flow_floors.npz")
+    assert set(stored.files) == set(JC_FLOOR_CASES)
     shot = _setup(paper_config, 1.0, 1.5, 0.6)
-    for name, params in cases.items():
-        np.testing.assert_allclose(run_shot(params, *hydro_inputs(paper_config, shot)).v_m_s, stored[name],
-                                   rtol=1e-10, atol=1e-10 * np.max(np.abs(stored[name])), err_msg=name)
+    for name, table_iv in JC_FLOOR_CASES.items():
+        np.testing.assert_allclose(run_shot(ShotParameters.from_table_iv(*table_iv), *hydro_inputs(paper_config, shot)).v_m_s,
+                                   stored[name], rtol=1e-10, atol=1e-10 * np.max(np.abs(stored[name])), err_msg=name)
 
 
 def test_thermal_factor_bound_lies_below_the_factor():

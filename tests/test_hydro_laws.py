@@ -40,7 +40,7 @@ LAW_RUNS = {
 }
 
 
-# traces stored from the code before the laws' floors (tests/data/law_traces_before_law_floors.npz, 2026-11-28):
+# traces stored from the code without the floor skips (tests/data/make_floor_free_traces.py):
 # the laws' sets above at 104S's speed, and sets from the strength-law comparison's posterior and prior runs
 SG_POSTERIOR = {"Y0_GPa": 0.3113, "Ymax_GPa": 0.8671, "beta": 843.3, "n": 0.04913, "G0_GPa": 36.48, "dGdP": 1.193,
                 "dGdT_over_G0_per_K": -0.0004817}
@@ -100,10 +100,10 @@ def test_steinberg_guinan_without_pressure_temperature_or_hardening_is_constant_
 
 def test_law_floors_change_no_trace():
     """The solver skips a law's flow stress where the cell's trial lies inside the law's floor (its cached
-    hardening, PTW's remembered floor; 2026-11-28): traces stored from the code before the floors (SG, PTW
-    and ZA, from test sets and from the strength-law comparison's posterior and prior runs) are reproduced
-    at the rounding floor (rtol 1e-10 of the peak: two code paths; bit for bit on the machine measured)."""
-    stored = np.load(Path(__file__).parent / "data" / "law_traces_before_law_floors.npz")
+    hardening): traces stored from the same code with the floor skips removed (SG, PTW and ZA, from test sets
+    and from the strength-law comparison's posterior and prior runs; tests/data/make_floor_free_traces.py) are
+    reproduced at the rounding floor (rtol 1e-10 of the peak: two code paths)."""
+    stored = np.load(Path(__file__).parent / "data" / "law_traces_without_law_floors.npz")
     assert set(stored.files) == set(LAW_FLOOR_CASES)
     for name, params in LAW_FLOOR_CASES.items():
         np.testing.assert_allclose(run_shot(params, THIN, AL5083).v_m_s, stored[name], rtol=1e-10,

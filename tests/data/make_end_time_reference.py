@@ -2,8 +2,8 @@
 
 The set: three seeded Latin-hypercube points per shot and two corners of the prior box where the
 free surface moves latest (small A, B, G and impact velocity; strong thermal softening). Made with
-the total-rate convention that reproduces FLAG, the exact-CDF extractor (2026-11-25; it moved one corner run's
-v_elastic by 2.9 m/s, a near-tie of EM optima) and `hydro.end_time_us: 4.0`; `tests/test_end_time.py` checks that
+the rate term at the step's plastic rate inside the return (regenerated 2026-11-29, issue 62), the
+exact-CDF extractor and `hydro.end_time_us: 4.0`; `tests/test_end_time.py` checks that
 `end_time_us: auto` reproduces these features within 0.05 m/s (and 0.5 ns).
 Run: python tests/data/make_end_time_reference.py
 """

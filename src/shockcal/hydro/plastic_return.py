@@ -1,19 +1,25 @@
 """A cell's return onto its strength law after the elastic trial (numba kernels on scalars, code units).
 
-One return serves every law of the registry (`shockcal.hydro.laws`): the law is evaluated only when the
-trial leaves the law's floor (`law_flow_stress_floor`: Johnson-Cook's A + B eps_p^n times the thermal
-factor it remembered, Steinberg-Guinan's exact flow stress, PTW's quasi-static one or the one it
-remembered at its last elastic evaluation, Zerilli-Armstrong's C0), read from the hardening the cell caches
-in `hard` and the floor it remembers in the cell's three floor slots. The skip is exact: a skipped cell is
-one the full evaluation would have left elastic. `plastic_return`, `cell_shear_modulus` and
-`initial_hardening` are compiled per law tuple type (`laws.kernels`) and inlined into the solver's
-`update_cells`.
+One return serves every law of the registry (`shockcal.hydro.laws`). A trial inside the rate-free yield
+surface (the flow stress at the cell's plastic strain and zero plastic rate, where every law's rate term is
+at its floor) is elastic; outside it the cell returns onto the flow stress at the plastic strain rate of
+the step being solved (`shockcal.hydro.consistent_return`), which for a rate-free law (Steinberg-Guinan) is
+the radial return. The rate-free flow stress is evaluated only when the trial leaves the law's floor
+(`law_flow_stress_floor`, a lower bound of it at any rate: Johnson-Cook's A + B eps_p^n times the thermal
+factor it remembered, Steinberg-Guinan's exact flow stress, PTW's quasi-static one, Zerilli-Armstrong's C0),
+read from the hardening the cell caches in `hard` and the floor it remembers in the cell's three floor slots.
+The skip is exact: a skipped cell is one the full evaluation would have left elastic. `plastic_return`,
+`cell_shear_modulus` and `initial_hardening` are compiled per law tuple type (`laws.kernels`) and inlined
+into the solver's `update_cells`.
 """
 
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
+from shockcal.hydro.consistent_return import law_plastic_increment
 from shockcal.hydro.laws.kernels import (
     law_flow_stress_cached,
     law_flow_stress_floor,
@@ -21,38 +27,38 @@ from shockcal.hydro.laws.kernels import (
     law_remember_floor,
     law_shear_modulus,
 )
-from shockcal.hydro.strength import equivalent_strain_rate, radial_return
 
 LAW_FLOOR_SLACK = 1.0 - 1e-9  # keeps a law's floor below its flow stress, computed along another path
+RATE_FREE = 0.0               # the plastic strain rate (1/us) of the rate-free yield surface
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def plastic_return(s_trial, T_cell, strain_rate, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
+def plastic_return(s_trial, T_cell, dt, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength,
                    material):
-    """A cell's return after its elastic trial deviator s_trial (Mbar), on scalars: (s, d eps_p, and the
-    cell's new eps_p, hard, flow_floor, floor_hotter, floor_T). Elastic while the trial lies inside the
-    law's floor (from the cell's cached hardening `hard`, its remembered floor in the flow_floor,
-    floor_hotter and floor_T slots, and G), else the trial returned onto the law's flow stress at the
-    cell's plastic strain, equivalent strain rate (1/us), temperature (K), pressure (Mbar) and density
-    ratio, with the cell's shear modulus G (Mbar). `hard` follows the plastic strain (`law_hardening`); an
+    """A cell's return after its elastic trial deviator s_trial (Mbar) over a step dt (us), on scalars: (s,
+    d eps_p, and the cell's new eps_p, hard, flow_floor, floor_hotter, floor_T). Elastic while the trial lies
+    inside the law's floor (from the cell's cached hardening `hard`, its remembered floor in the flow_floor,
+    floor_hotter and floor_T slots, and G) or inside the rate-free flow stress at the cell's plastic strain,
+    temperature (K), pressure (Mbar), density ratio and shear modulus G (Mbar); else the consistent return
+    onto the flow stress at the step's plastic rate. `hard` follows the plastic strain (`law_hardening`); an
     elastic full evaluation sets the remembered floor (`law_remember_floor`). A cell with G = 0 (molten)
     carries no deviator and gains no plastic strain. `material` is not used (the law's tuple holds its
     material constants). Scalars in and out: inlined code that indexes the cell arrays cost the 104S run
     23% more CPU (reference counts per cell)."""
     if G <= 0.0:
         return 0.0, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    law, rate = strength.law, equivalent_strain_rate(strain_rate)
-    floor = law_flow_stress_floor(law, hard, G, rate, T_cell, eta, flow_floor, floor_hotter, floor_T)
-    if 1.5 * abs(s_trial) <= LAW_FLOOR_SLACK * floor:
+    law, equivalent = strength.law, 1.5 * abs(s_trial)
+    if equivalent <= LAW_FLOOR_SLACK * law_flow_stress_floor(law, hard, G, T_cell, eta, flow_floor, floor_hotter,
+                                                              floor_T):
         return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
-    s_new, d_eps = radial_return(s_trial, law_flow_stress_cached(law, hard, G, eps_p, rate, T_cell, P, eta), G)
-    if d_eps > 0.0:
-        eps_p += d_eps
-        hard = law_hardening(law, eps_p)
-    else:
-        flow_floor, floor_hotter, floor_T = law_remember_floor(law, G, eps_p, rate, T_cell, eta, flow_floor,
-                                                               floor_hotter, floor_T)
-    return s_new, d_eps, eps_p, hard, flow_floor, floor_hotter, floor_T
+    rate_free = law_flow_stress_cached(law, hard, G, eps_p, RATE_FREE, T_cell, P, eta)
+    if equivalent <= rate_free:
+        flow_floor, floor_hotter, floor_T = law_remember_floor(law, G, eps_p, T_cell, eta, flow_floor, floor_hotter,
+                                                               floor_T)
+        return s_trial, 0.0, eps_p, hard, flow_floor, floor_hotter, floor_T
+    d_eps, flow = law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T_cell, P, eta)
+    eps_p += d_eps
+    return math.copysign(flow / 1.5, s_trial), d_eps, eps_p, law_hardening(law, eps_p), flow_floor, floor_hotter, floor_T
 
 
 @njit(cache=True, error_model="numpy", inline="always")

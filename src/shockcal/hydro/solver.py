@@ -23,9 +23,10 @@ rear node nf and the target's front node nf+1. Both outer nodes are free surface
    velocity and the energy an impact dissipates goes to the interface cells; under tension the
    nodes separate, which opens the interface;
 3. `update_cells`: length from the node velocities, strain rate, artificial viscosity (compression
-   only), the cell's shear modulus, elastic trial deviator and radial return onto the strength law
-   (`shockcal.hydro.plastic_return`: the law's skipped while the trial lies inside the cell's flow-stress floor,
-   `laws.kernels.law_flow_stress_floor`), energy equation, EOS;
+   only), the cell's shear modulus, elastic trial deviator and return onto the strength law
+   (`shockcal.hydro.plastic_return`: elastic inside the rate-free flow stress, skipped while the trial lies
+   inside the cell's flow-stress floor; outside, the consistent return at the step's plastic strain rate,
+   `shockcal.hydro.consistent_return`), energy equation, EOS;
 4. time step: CFL on the longitudinal sound speed, viscosity included (`signal_speed`), growth
    limited to 10%.
 The material, strength and numerics parameters travel as named tuples in code units
@@ -191,7 +192,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
         s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j] = plastic_return(
-            s_trial, T_cell, strain_rate, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
+            s_trial, T_cell, dt, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
             strength, material)
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume

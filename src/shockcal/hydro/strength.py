@@ -1,13 +1,14 @@
-"""Johnson-Cook flow stress and von Mises radial return in uniaxial strain (SPEC section 2).
+"""Johnson-Cook's factors in uniaxial strain (SPEC section 2).
 
-    Y = (A + B eps_p^n) (1 + C ln(epsdot / epsdot_0)) (1 - T*^m),  T* = (T - T_ref)/(T_melt - T_ref)
+    Y = (A + B eps_p^n) (1 + C ln(epsdot_p / epsdot_0)) (1 - T*^m),  T* = (T - T_ref)/(T_melt - T_ref)
 
 Conventions (also in docs/hydro.md):
-- epsdot is the current step's total equivalent strain rate, (2/3)|d eps_xx/dt| in uniaxial strain
-  (the usual explicit-code convention, and the one that reproduces FLAG's features). The paper writes
-  the plastic rate; taken from the previous step (an explicit lag) it makes the rate term vanish
-  wherever the stress relaxes slowly: a numerical artefact, not physics. The plastic rate is kept
-  as a diagnostic only;
+- epsdot_p is the equivalent plastic strain rate of the step being solved, d eps_p / dt, as the paper
+  writes it: the return solves for the plastic strain increment with the flow stress at that rate
+  (`shockcal.hydro.consistent_return`, backward Euler, as production codes do). Evaluated instead on
+  the step's total strain rate, explicitly beside the return (the convention before 2026-11-29, FLAG's),
+  the rate term acted as a stiff viscosity whose explicit stability limit lies far below the CFL step:
+  it rang at the rounding level and moved with the time step (docs/journal/hydro.md);
 - the rate ratio is floored at 1: ln(max(epsdot / epsdot_0, 1)), so the rate term never softens;
 - n = 0 means eps_p^0 = 1 (Y = A + B), including at eps_p = 0;
 - T* <= 0 gives no thermal softening; T* >= 1 gives Y = 0 (melt);
@@ -15,7 +16,7 @@ Conventions (also in docs/hydro.md):
   m = 0 exactly is treated as that limit (Y = 0 for T* > 0, full strength at T* <= 0); no NaN.
 
 In uniaxial strain the deviator is diag(s, -s/2, -s/2) with s = s_xx; von Mises equivalent stress
-is 3|s|/2, and the increment of equivalent plastic strain of a radial return is (3|s|/2 - Y)/(3G).
+is 3|s|/2, and a return from the trial s onto a flow stress Y gains (3|s|/2 - Y)/(3G) of plastic strain.
 """
 
 import math
@@ -40,18 +41,6 @@ def rate_factor(C, strain_rate, strain_rate_ref):
     """1 + C ln(max(rate/rate_ref, 1))."""
     ratio = strain_rate / strain_rate_ref
     return 1.0 + C * math.log(ratio) if ratio > 1.0 else 1.0
-
-
-@njit(cache=True, error_model="numpy")
-def equivalent_strain_rate(strain_rate_xx):
-    """Von Mises equivalent of a uniaxial-strain rate: (2/3)|d eps_xx/dt| (same unit as the input)."""
-    return (2.0 / 3.0) * abs(strain_rate_xx)
-
-
-@njit(cache=True, error_model="numpy")
-def flow_stress(hardening_stress, thermal, C, strain_rate_xx, strain_rate_ref):
-    """Johnson-Cook flow stress (Mbar) from A + B eps_p^n, 1 - T*^m and the current total strain rate."""
-    return hardening_stress * rate_factor(C, equivalent_strain_rate(strain_rate_xx), strain_rate_ref) * thermal
 
 
 @njit(cache=True, error_model="numpy")
@@ -80,13 +69,3 @@ def thermal_factor_below(m, homologous_T, thermal, d_homologous_T):
     else:
         return 0.0
     return max(1.0 - (1.0 - thermal) * growth - BOUND_ROUNDING, 0.0)
-
-
-@njit(cache=True, error_model="numpy")
-def radial_return(s_trial, flow_stress, G):
-    """Return (s, d eps_p): the trial deviator scaled back onto the yield surface if outside it."""
-    equivalent = 1.5 * abs(s_trial)
-    if equivalent <= flow_stress:
-        return s_trial, 0.0
-    s = math.copysign(flow_stress / 1.5, s_trial)
-    return s, (equivalent - flow_stress) / (3.0 * G)

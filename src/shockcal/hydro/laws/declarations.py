@@ -20,6 +20,7 @@ from shockcal.hydro.laws.johnson_cook import (
     johnson_cook_flow_stress_floor,
     johnson_cook_flow_stress_from_hardening,
     johnson_cook_hardening,
+    johnson_cook_plastic_increment,
     johnson_cook_remember_floor,
 )
 from shockcal.hydro.laws.preston_tonks_wallace import (
@@ -28,7 +29,6 @@ from shockcal.hydro.laws.preston_tonks_wallace import (
     ptw_flow_stress_at,
     ptw_flow_stress_floor,
     ptw_hardening,
-    ptw_remember_floor,
     ptw_shear_modulus,
 )
 from shockcal.hydro.laws.steinberg_guinan import (
@@ -90,11 +90,14 @@ class Law:
     (text, predicate on the user values); `melt_temperature(law, eta)` (K), where the strength vanishes, for
     the laws that have one. Optional kernels that spare the solver work (`shockcal.hydro.laws.kernels`):
     `flow_stress_at(law, G, eps_p, rate, T, P, eta)` for a law with a modulus law (the flow stress with
-    the cell's G, not recomputed), `flow_stress_floor(law, hard, G, rate, T, eta, flow_floor, floor_hotter,
-    floor_T)`, a proven lower bound of the flow stress from `hardening(law, eps_p)`, which the solver caches
-    per cell, and from the floor `remember_floor(law, G, eps_p, rate, T, eta, ...)` sets after a full
+    the cell's G, not recomputed), `flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter,
+    floor_T)`, a proven lower bound of the flow stress at any rate from `hardening(law, eps_p)`, which the
+    solver caches per cell, and from the floor `remember_floor(law, G, eps_p, T, eta, ...)` sets after a full
     evaluation found the cell elastic; `flow_stress_from_hardening(law, hard, rate, T)`, the flow stress from
-    that cached hardening (for a law whose flow stress is its hardening times factors of rate and T). A
+    that cached hardening (for a law whose flow stress is its hardening times factors of rate and T).
+    `rate_dependent`: whether the flow stress has a rate term, which the solver's return then evaluates at the
+    step's plastic strain rate (`shockcal.hydro.consistent_return`); `plastic_increment(law, equivalent,
+    rate_free, G, dt)`, the law's own solution of that return (Johnson-Cook's closed form). A
     study's design columns (`column`): the kernel's fields in code units for a law with `code_unit_columns`
     (Johnson-Cook, whose box a study gives in `inputs`), else the declared names in user units (a box in
     `strength.inputs` or config/models.yaml). `roles` names the parameters that study code reads by their
@@ -115,6 +118,8 @@ class Law:
     flow_stress_floor: Callable | None = None
     remember_floor: Callable | None = None
     flow_stress_from_hardening: Callable | None = None
+    rate_dependent: bool = True
+    plastic_increment: Callable | None = None
     code_unit_columns: bool = False
     roles: Mapping[str, str] = field(default_factory=dict)
 
@@ -160,6 +165,7 @@ JOHNSON_COOK = Law(
     melt_temperature=lambda law, eta: law.T_melt,
     hardening=johnson_cook_hardening, flow_stress_floor=johnson_cook_flow_stress_floor,
     remember_floor=johnson_cook_remember_floor, flow_stress_from_hardening=johnson_cook_flow_stress_from_hardening,
+    plastic_increment=johnson_cook_plastic_increment,
     code_unit_columns=True,
     roles={"yield_stress": "A_MPa", "rate_coefficient": "C", "hardening_exponent": "n", "thermal_exponent": "m"},
 )
@@ -186,7 +192,7 @@ STEINBERG_GUINAN = Law(
                  ("beta >= 0 and eps_i >= 0", lambda v: v["beta"] >= 0 and v["eps_i"] >= 0)),
     melt_temperature=steinberg_guinan_melt_temperature,
     flow_stress_at=steinberg_guinan_flow_stress_at, hardening=steinberg_guinan_hardening,
-    flow_stress_floor=steinberg_guinan_flow_stress_floor,
+    flow_stress_floor=steinberg_guinan_flow_stress_floor, rate_dependent=False,
 )
 
 PRESTON_TONKS_WALLACE = Law(
@@ -220,7 +226,6 @@ PRESTON_TONKS_WALLACE = Law(
     ),
     melt_temperature=lambda law, eta: law.T_melt,
     flow_stress_at=ptw_flow_stress_at, hardening=ptw_hardening, flow_stress_floor=ptw_flow_stress_floor,
-    remember_floor=ptw_remember_floor,
 )
 
 ZERILLI_ARMSTRONG = Law(

@@ -3,21 +3,30 @@
     Y = (A + B eps_p^n) (1 + C ln(epsdot / epsdot_0)) (1 - T*^m),   T* = (T - T_ref) / (T_melt - T_ref)
 
 with the project's conventions (docs/hydro.md, `hydro/strength.py`): the rate ratio floored at 1,
-n = 0 meaning eps_p^0 = 1, no softening at T* <= 0 and none left at T* >= 1. The kernel calls
-`hardening`, `rate_factor` and `thermal_factor` in the order `hydro.strength.flow_stress` uses, so
-it equals the hydrocode's Johnson-Cook flow stress bit for bit (tests/test_strength_laws.py).
+n = 0 meaning eps_p^0 = 1, no softening at T* <= 0 and none left at T* >= 1: the product of `hardening`,
+`rate_factor` and `thermal_factor` (`hydro.strength`) in that order (tests/test_strength_laws.py).
 
 The solver's floor (`shockcal.hydro.plastic_return.plastic_return`): the cell caches A + B eps_p^n in `hard`
 (`johnson_cook_hardening`) and remembers, at its last full evaluation that found it elastic, the thermal
 factor 1 - T*^m at that temperature (`flow_floor`), a lower bound of it FLOOR_MARGIN_K hotter
 (`floor_hotter`, `thermal_factor_below`: no extra pow) and the temperature (`floor_T`). The floor is `hard`
-times the remembered factor that holds at the cell's temperature times the rate factor: a lower bound of the
-flow stress (the thermal factor falls with T, `hard` holds the current plastic strain), so an elastic cell
-costs at most one log and no pow.
+times the remembered factor that holds at the cell's temperature: a lower bound of the flow stress at any
+rate (the thermal factor falls with T, `hard` holds the current plastic strain, the rate factor is >= 1), so
+an elastic cell costs no pow and no log.
+
+The consistent return (`johnson_cook_plastic_increment`) has a closed form up to one scalar equation: with
+the rate-free flow stress Y0 = (A + B eps_p^n)(1 - T*^m), the increment d = d_ref e^x at the reference rate's
+increment d_ref = dt epsdot_0 solves
+
+    3/2 |s_trial| - 3 G d_ref e^x = Y0 (1 + C x),   x = ln(d / d_ref) > 0,
+
+the form whose root is a Lambert W; solved by Halley's steps in x from an upper bound of the root (each
+term of the left side alone), the increment read from the last step's exponential (e^step to second order).
 """
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 from numba import njit
@@ -26,6 +35,8 @@ from shockcal.hydro.strength import hardening, rate_factor, thermal_factor, ther
 
 FLOOR_MARGIN_K = 1.0       # a cell's hotter floor holds up to this much above the temperature it was set at
 FLOOR_SLACK = 1.0 - 1e-12  # keeps the remembered thermal factor below the exact one through rounding
+STEP_STOP = 1e-6           # a Halley step in x = ln(d / d_ref) this small leaves an error about 1e-18 (cubic)
+NEWTON_MAX_STEPS = 60
 
 
 class JohnsonCook(NamedTuple):
@@ -70,24 +81,45 @@ def johnson_cook_hardening(law, eps_p):
 
 
 @njit(cache=True, error_model="numpy")
-def johnson_cook_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    """A lower bound (Mbar) of the flow stress: `hard` (A + B eps_p^n, Mbar) times the thermal factor the
-    cell remembered at floor_T (K) while T (K) is no hotter, the one FLOOR_MARGIN_K hotter up to that, else
-    -1 (none), times the rate factor at the equivalent strain rate (1/us). G and eta are not used."""
+def johnson_cook_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
+    """A lower bound (Mbar) of the flow stress at any rate: `hard` (A + B eps_p^n, Mbar) times the thermal
+    factor the cell remembered at floor_T (K) while T (K) is no hotter, the one FLOOR_MARGIN_K hotter up to
+    that, else -1 (none). G and eta are not used."""
     if T <= floor_T:
-        thermal = flow_floor
-    elif T <= floor_T + FLOOR_MARGIN_K:
-        thermal = floor_hotter
-    else:
-        return -1.0
-    return hard * thermal * rate_factor(law.C, strain_rate, law.rate_ref)
+        return hard * flow_floor
+    if T <= floor_T + FLOOR_MARGIN_K:
+        return hard * floor_hotter
+    return -1.0
 
 
 @njit(cache=True, error_model="numpy")
-def johnson_cook_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+def johnson_cook_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T):
     """The cell's remembered thermal factors after a full evaluation found it elastic at T (K): 1 - T*^m
     and its lower bound FLOOR_MARGIN_K hotter, each just below by FLOOR_SLACK, and T."""
     homologous = _homologous(law, T)
     thermal = thermal_factor(law.m, homologous)
     margin = FLOOR_MARGIN_K * (1.0 / (law.T_melt - law.T_ref))
     return (FLOOR_SLACK * thermal, FLOOR_SLACK * thermal_factor_below(law.m, homologous, thermal, margin), T)
+
+
+@njit(cache=True, error_model="numpy")
+def johnson_cook_plastic_increment(law, equivalent, rate_free, G, dt):
+    """The consistent return's plastic strain increment d and the flow stress Y (Mbar) at the step's plastic
+    rate d / dt (module docstring), for a trial von Mises stress `equivalent` (Mbar) above the rate-free flow
+    stress `rate_free` (Mbar), shear modulus G (Mbar) and time step dt (us). Below the reference rate (or
+    with C <= 0) the rate-free radial return: d = (equivalent - rate_free) / (3 G), Y = rate_free."""
+    overstress = equivalent - rate_free
+    d_free, d_ref = overstress / (3.0 * G), dt * law.rate_ref
+    slope_x = rate_free * law.C                     # dY/dx
+    if d_free <= d_ref or slope_x <= 0.0:
+        return d_free, rate_free
+    elastic_ref = 3.0 * G * d_ref                   # the stress 3 G d_ref e^x at x = 0
+    x = min(overstress / slope_x, math.log(overstress / elastic_ref))   # each term alone: above the root
+    for _ in range(NEWTON_MAX_STEPS):
+        elastic = elastic_ref * math.exp(x)
+        residual, slope = overstress - elastic - slope_x * x, elastic + slope_x     # r and -dr/dx
+        step = 2.0 * residual * slope / (2.0 * slope * slope + residual * elastic)   # Halley's step
+        x += step
+        if abs(step) <= STEP_STOP:
+            break
+    return elastic / (3.0 * G) * (1.0 + step * (1.0 + 0.5 * step)), rate_free * (1.0 + law.C * x)

@@ -9,10 +9,10 @@ compiles (no run-time branch, no function objects passed around, so callers stay
     law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta) -> Mbar   (law_flow_stress_at, from the
                                                       cell's cached hardening `hard` where the law can use it)
     law_hardening(law, eps_p) -> the law's cached hardening (0 for laws without one)
-    law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T) -> Mbar
-        (a proven lower bound of the flow stress from the cell's cached hardening and remembered floor,
-         -1 where the law has none)
-    law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+    law_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T) -> Mbar
+        (a proven lower bound of the flow stress at any strain rate from the cell's cached hardening and
+         remembered floor, -1 where the law has none)
+    law_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T)
         -> the cell's new remembered floor (flow_floor, floor_hotter, floor_T), the old one for laws
            that remember none
 
@@ -31,7 +31,7 @@ from numba.extending import overload
 from shockcal.hydro.laws.declarations import LAWS
 
 
-def _law_of(law_type):
+def declared_law(law_type):
     """The declared law whose named tuple has this numba type (or Python class)."""
     cls = getattr(law_type, "instance_class", law_type)
     for law in LAWS.values():
@@ -42,24 +42,24 @@ def _law_of(law_type):
 
 def law_flow_stress(law, eps_p, strain_rate, T, P, eta):
     """Flow stress (Mbar) of the law whose parameters `law` holds."""
-    return _law_of(type(law)).flow_stress(law, eps_p, strain_rate, T, P, eta)
+    return declared_law(type(law)).flow_stress(law, eps_p, strain_rate, T, P, eta)
 
 
 def law_shear_modulus(law, G, P, T, eta):
     """The law's shear modulus (Mbar) at P (Mbar), T (K), eta; `G` (Mbar) for laws without a modulus law."""
-    modulus = _law_of(type(law)).shear_modulus
+    modulus = declared_law(type(law)).shear_modulus
     return G if modulus is None else modulus(law, P, T, eta)
 
 
 @overload(law_flow_stress, jit_options={"cache": True})
 def _law_flow_stress(law, eps_p, strain_rate, T, P, eta):
-    kernel = _law_of(law).flow_stress
+    kernel = declared_law(law).flow_stress
     return lambda law, eps_p, strain_rate, T, P, eta: kernel(law, eps_p, strain_rate, T, P, eta)
 
 
 @overload(law_shear_modulus, jit_options={"cache": True})
 def _law_shear_modulus(law, G, P, T, eta):
-    modulus = _law_of(law).shear_modulus
+    modulus = declared_law(law).shear_modulus
     if modulus is None:
         return lambda law, G, P, T, eta: G
     return lambda law, G, P, T, eta: modulus(law, P, T, eta)
@@ -67,7 +67,7 @@ def _law_shear_modulus(law, G, P, T, eta):
 
 def law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
     """Flow stress (Mbar) where the law's shear modulus is G (Mbar); laws without a modulus law ignore G."""
-    kernel = _law_of(type(law)).flow_stress_at
+    kernel = declared_law(type(law)).flow_stress_at
     if kernel is None:
         return law_flow_stress(law, eps_p, strain_rate, T, P, eta)
     return kernel(law, G, eps_p, strain_rate, T, P, eta)
@@ -76,7 +76,7 @@ def law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
 def law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
     """`law_flow_stress_at`, read from the cell's cached hardening `hard` (`law_hardening(law, eps_p)`) by a law
     that declares `flow_stress_from_hardening` (the same value bit for bit)."""
-    kernel = _law_of(type(law)).flow_stress_from_hardening
+    kernel = declared_law(type(law)).flow_stress_from_hardening
     if kernel is None:
         return law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta)
     return kernel(law, hard, strain_rate, T)
@@ -84,7 +84,7 @@ def law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
 
 @overload(law_flow_stress_cached, jit_options={"cache": True})
 def _law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
-    kernel = _law_of(law).flow_stress_from_hardening
+    kernel = declared_law(law).flow_stress_from_hardening
     if kernel is None:
         return lambda law, hard, G, eps_p, strain_rate, T, P, eta: law_flow_stress_at(law, G, eps_p, strain_rate, T,
                                                                                      P, eta)
@@ -93,58 +93,57 @@ def _law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta):
 
 def law_hardening(law, eps_p):
     """The law's hardening at `eps_p` that its floor reads (0.0 for a law without one)."""
-    kernel = _law_of(type(law)).hardening
+    kernel = declared_law(type(law)).hardening
     return 0.0 if kernel is None else kernel(law, eps_p)
 
 
-def law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    """A lower bound (Mbar) of the law's flow stress at the cell's plastic strain (through `hard`), shear
-    modulus G (Mbar), equivalent strain rate (1/us), temperature (K) and eta, from the cached hardening and
-    the remembered floor (flow_floor, floor_hotter, floor_T: their meaning is the law's); -1.0 when none."""
-    kernel = _law_of(type(law)).flow_stress_floor
-    return -1.0 if kernel is None else kernel(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+def law_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
+    """A lower bound (Mbar) of the law's flow stress at any strain rate, at the cell's plastic strain (through
+    `hard`), shear modulus G (Mbar), temperature (K) and eta, from the cached hardening and the remembered
+    floor (flow_floor, floor_hotter, floor_T: their meaning is the law's); -1.0 when none."""
+    kernel = declared_law(type(law)).flow_stress_floor
+    return -1.0 if kernel is None else kernel(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T)
 
 
-def law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+def law_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T):
     """The cell's remembered floor after a full evaluation found it elastic at this state; the given one
     for a law that remembers none."""
-    kernel = _law_of(type(law)).remember_floor
+    kernel = declared_law(type(law)).remember_floor
     if kernel is None:
         return flow_floor, floor_hotter, floor_T
-    return kernel(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+    return kernel(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T)
 
 
 @overload(law_flow_stress_at, jit_options={"cache": True})
 def _law_flow_stress_at(law, G, eps_p, strain_rate, T, P, eta):
-    kernel = _law_of(law).flow_stress_at
+    kernel = declared_law(law).flow_stress_at
     if kernel is None:
-        flow = _law_of(law).flow_stress
+        flow = declared_law(law).flow_stress
         return lambda law, G, eps_p, strain_rate, T, P, eta: flow(law, eps_p, strain_rate, T, P, eta)
     return lambda law, G, eps_p, strain_rate, T, P, eta: kernel(law, G, eps_p, strain_rate, T, P, eta)
 
 
 @overload(law_hardening, jit_options={"cache": True})
 def _law_hardening(law, eps_p):
-    kernel = _law_of(law).hardening
+    kernel = declared_law(law).hardening
     if kernel is None:
         return lambda law, eps_p: 0.0
     return lambda law, eps_p: kernel(law, eps_p)
 
 
 @overload(law_flow_stress_floor, jit_options={"cache": True})
-def _law_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    kernel = _law_of(law).flow_stress_floor
+def _law_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
+    kernel = declared_law(law).flow_stress_floor
     if kernel is None:
-        return lambda law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: -1.0
-    return lambda law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: kernel(
-        law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+        return lambda law, hard, G, T, eta, flow_floor, floor_hotter, floor_T: -1.0
+    return lambda law, hard, G, T, eta, flow_floor, floor_hotter, floor_T: kernel(law, hard, G, T, eta, flow_floor,
+                                                                                  floor_hotter, floor_T)
 
 
 @overload(law_remember_floor, jit_options={"cache": True})
-def _law_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    kernel = _law_of(law).remember_floor
+def _law_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T):
+    kernel = declared_law(law).remember_floor
     if kernel is None:
-        return lambda law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: (
-            flow_floor, floor_hotter, floor_T)
-    return lambda law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T: kernel(
-        law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T)
+        return lambda law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T: (flow_floor, floor_hotter, floor_T)
+    return lambda law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T: kernel(law, G, eps_p, T, eta, flow_floor,
+                                                                                   floor_hotter, floor_T)

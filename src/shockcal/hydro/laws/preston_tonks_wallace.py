@@ -79,15 +79,6 @@ def ptw_rate_ratio(law, G, strain_rate, eta):
 
 
 @njit(cache=True, error_model="numpy")
-def ptw_rate_ratio_sixth(law, G, strain_rate, eta):
-    """r^6 without a root: r = epsdot eta^(1/6) / (K sqrt(G)), K = gamma / 2 (4 pi rho0 N_A / (3 M))^(1/3) / sqrt(rho0),
-    so r^6 = epsdot^6 eta / (K^6 G^3), K^6 = gamma^6 / 64 (4 pi rho0 N_A / (3 M))^2 / rho0^3."""
-    k_sixth = law.gamma ** 6 / 64.0 * (4.0 * math.pi * law.rho0 * AVOGADRO / (3.0 * law.M)) ** 2 / law.rho0 ** 3
-    rate_cubed = strain_rate * strain_rate * strain_rate
-    return rate_cubed * rate_cubed * eta / (k_sixth * G * G * G)
-
-
-@njit(cache=True, error_model="numpy")
 def ptw_hardened(law, tau_s, tau_y, eps_p):
     """tau^ at equivalent plastic strain `eps_p` between the yield `tau_y` and saturation `tau_s` stresses
     (over G): eq. (6), tau_s when tau_y >= tau_s."""
@@ -135,59 +126,33 @@ def ptw_flow_stress(law, eps_p, strain_rate, T, P, eta):
     return ptw_flow_stress_at(law, ptw_shear_modulus(law, P, T, eta), eps_p, strain_rate, T, P, eta)
 
 
-# Floors: lower bounds of the flow stress that let the solver skip it in provably elastic cells (exact).
-# 1. Quasi-static: tau^ >= its value at r = 0 (tau_s = sinf, tau_y = yinf) at the same eps_p, for every r.
-#    At any r, thermal <= 1 = its value at r = 0, so tau_s >= sinf and tau_y >= yinf (s0 > sinf, y0 > yinf;
-#    the power branches only raise them). Eq. (6) solves dtau/dpsi = theta (exp(k (tau_s - tau)) - 1) /
-#    (exp(k (tau_s - tau_y)) - 1), tau(0) = tau_y, k = p / (s0 - tau_y), theta >= 0. It does not fall as
-#    tau_s rises: d tau / d tau_s = 1 - exp(-w) (exp(-x) + w) / (1 - (1 - exp(-x)) exp(-w)) >= 0, since
-#    w exp(-w) <= 1 - exp(-w) (x = k (tau_s - tau_y), w = k theta psi / (exp(x) - 1)). Nor as tau_y rises
-#    while tau_s <= s0: the start rises, and the right-hand side grows with k while k (tau_s - tau_y)
-#    falls. So raise tau_y from yinf at tau_s = sinf <= s0, then tau_s; tau_y >= tau_s gives tau_s, above
-#    every value below it; tau_y >= s0 (only for r > 1) gives tau^ >= min(tau_s, tau_y) >= s0.
-# 2. Remembered: for r <= 1 (log(1/r) >= 0) and kappa, beta, y2 >= 0, tau_s and tau_y do not fall as r
-#    rises or as T falls, so tau^ at (r, T, eps_p) is at least its value at any (r_f <= r, T_f >= T,
-#    eps_p_f <= eps_p). After a full evaluation finds a cell elastic, it remembers tau^ at
-#    r_f = r PTW_FLOOR_RATE_FACTOR and T_f = T + PTW_FLOOR_MARGIN_K (the cell's flow_floor, floor_hotter
-#    and floor_T slots: tau^, r_f^6, T_f); the floor holds while r_f <= r <= 1 and T <= T_f (eps_p only
-#    grows), checked on r^6, which needs no root (`ptw_rate_ratio_sixth`).
-PTW_FLOOR_RATE_FACTOR = math.exp(-0.5)   # measured best of e^-0.1 .. e^-3 on 105S posterior runs
-PTW_FLOOR_MARGIN_K = 1.0                 # measured best of 0.2 .. 10 K
+# Floor: a lower bound of the flow stress that lets the solver skip it in provably elastic cells (exact).
+# Quasi-static: tau^ >= its value at r = 0 (tau_s = sinf, tau_y = yinf) at the same eps_p, for every r.
+# At any r, thermal <= 1 = its value at r = 0, so tau_s >= sinf and tau_y >= yinf (s0 > sinf, y0 > yinf;
+# the power branches only raise them). Eq. (6) solves dtau/dpsi = theta (exp(k (tau_s - tau)) - 1) /
+# (exp(k (tau_s - tau_y)) - 1), tau(0) = tau_y, k = p / (s0 - tau_y), theta >= 0. It does not fall as
+# tau_s rises: d tau / d tau_s = 1 - exp(-w) (exp(-x) + w) / (1 - (1 - exp(-x)) exp(-w)) >= 0, since
+# w exp(-w) <= 1 - exp(-w) (x = k (tau_s - tau_y), w = k theta psi / (exp(x) - 1)). Nor as tau_y rises
+# while tau_s <= s0: the start rises, and the right-hand side grows with k while k (tau_s - tau_y)
+# falls. So raise tau_y from yinf at tau_s = sinf <= s0, then tau_s; tau_y >= tau_s gives tau_s, above
+# every value below it; tau_y >= s0 (only for r > 1) gives tau^ >= min(tau_s, tau_y) >= s0.
 
 
 @njit(cache=True, error_model="numpy")
 def ptw_floors_hold(law):
-    """Whether the floors' monotonicity holds: theta, kappa, beta, y2 >= 0 (the boxes' values)."""
+    """Whether the floor's monotonicity holds: theta, kappa, beta, y2 >= 0 (the boxes' values)."""
     return law.theta >= 0.0 and law.kappa >= 0.0 and law.beta >= 0.0 and law.y2 >= 0.0
 
 
 @njit(cache=True, error_model="numpy")
 def ptw_hardening(law, eps_p):
     """tau^ (over G) at `eps_p` in the quasi-static limit (r = 0: tau_s = sinf, tau_y = yinf), the cell's
-    cached hardening; -1 where the floors do not hold."""
+    cached hardening; -1 where the floor does not hold."""
     return ptw_hardened(law, law.sinf, law.yinf, eps_p) if ptw_floors_hold(law) else -1.0
 
 
 @njit(cache=True, error_model="numpy")
-def ptw_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    """A lower bound (Mbar) of the flow stress at shear modulus G (Mbar), equivalent strain rate (1/us),
-    temperature T (K) and eta: 2 G times the cell's remembered tau^ `flow_floor` while it holds (r^6
-    from `floor_hotter` to 1, T <= `floor_T`), else 2 G `hard`, the quasi-static tau^; -1 (none)
-    where the floors do not hold."""
-    if hard < 0.0:
-        return -1.0
-    if flow_floor > hard and T <= floor_T and floor_hotter <= ptw_rate_ratio_sixth(law, G, strain_rate, eta) <= 1.0:
-        return 2.0 * G * flow_floor
-    return 2.0 * G * hard
-
-
-@njit(cache=True, error_model="numpy")
-def ptw_remember_floor(law, G, eps_p, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
-    """The cell's remembered floor after a full evaluation found it elastic: (tau^ at r_f and T_f, r_f^6,
-    T_f) with r_f = r PTW_FLOOR_RATE_FACTOR, T_f = T + PTW_FLOOR_MARGIN_K; the old one kept where none
-    can be set (r > 1, or the floors do not hold)."""
-    r = ptw_rate_ratio(law, G, strain_rate, eta)
-    if r > 1.0 or not ptw_floors_hold(law):
-        return flow_floor, floor_hotter, floor_T
-    r_floor, T_floor = r * PTW_FLOOR_RATE_FACTOR, T + PTW_FLOOR_MARGIN_K
-    return ptw_tau(law, r_floor, T_floor, eps_p), r_floor ** 6, T_floor
+def ptw_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
+    """A lower bound (Mbar) of the flow stress at any strain rate, at shear modulus G (Mbar): 2 G `hard`, the
+    quasi-static tau^; -1 (none) where the floor does not hold. Nothing remembered is used."""
+    return -1.0 if hard < 0.0 else 2.0 * G * hard

@@ -84,7 +84,7 @@ def steinberg_guinan_flow_stress(law, eps_p, strain_rate, T, P, eta):
 
 
 @njit(cache=True, error_model="numpy")
-def steinberg_guinan_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+def steinberg_guinan_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
     """The flow stress itself (Mbar) from the cell's cached `steinberg_guinan_hardening` and its G (Mbar):
     the law has no rate term, so its floor is exact and nothing is remembered."""
     return hard * G / law.G0

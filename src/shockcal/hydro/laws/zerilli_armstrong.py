@@ -40,7 +40,7 @@ def zerilli_armstrong_flow_stress(law, eps_p, strain_rate, T, P, eta):
 
 
 @njit(cache=True, error_model="numpy")
-def zerilli_armstrong_flow_stress_floor(law, hard, G, strain_rate, T, eta, flow_floor, floor_hotter, floor_T):
+def zerilli_armstrong_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T):
     """C0 (Mbar), a lower bound of the flow stress at any strain, rate and temperature when C2 >= 0
     (the exponential is positive); -1 (none) otherwise. Nothing cached or remembered is used."""
     return law.C0 if law.C2 >= 0.0 else -1.0

@@ -1,0 +1,98 @@
+"""The rate-dependent return solved consistently: backward Euler on the equivalent plastic strain.
+
+In a plastic step of length dt the increment d > 0 of equivalent plastic strain solves
+
+    3/2 |s_trial| - 3 G d = Y(eps_p, d / dt, T, P, eta),
+
+the flow stress at the plastic strain rate of the step being solved: the radial return of Wilkins (1964)
+made implicit in the rate (Simo & Hughes 1998, Computational Inelasticity, sec. 3.3 and 3.7, the
+viscoplastic return; Ponthot 2002, Int. J. Plasticity 18, 91, for rate-dependent laws such as
+Johnson-Cook). The hardening is read at the step's start, as the rate-free radial return reads it, so a
+law without a rate term (or C = 0) returns exactly as that return does; the rate, the stiff term, is
+implicit. The returned deviator is s = sign(s_trial) Y / (3/2), on the yield surface at the step's plastic
+rate.
+
+`law_plastic_increment` picks, when numba compiles: the law's own solution where it declares one
+(`Law.plastic_increment`: Johnson-Cook's closed form), the radial return for a rate-free law
+(Steinberg-Guinan, bit for bit as before), else `bracketed_plastic_increment`, which any law's kernel
+serves.
+
+`bracketed_plastic_increment`: the residual r(d) = 3/2 |s_trial| - 3 G d - Y(d) falls strictly with d (Y
+does not fall as the plastic rate grows). At d = 0 the plastic rate is 0, where each law reads its own limit
+(PTW's quasi-static r = 0; Zerilli-Armstrong's C0), so r(0) > 0 for a plastic trial; at the rate-free
+return's increment r <= 0. The root is bracketed there and found by Newton steps in ln d, where the rate
+terms are close to linear, the slope of Y a secant through the last two iterates (a law need not supply
+one); a step that leaves the bracket is replaced by a bisection (in ln d once the bracket's lower end is
+positive). It stops when a step would move d by at most RELATIVE_TOLERANCE of d, or after MAX_ITERATIONS.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+from numba.extending import overload
+
+from shockcal.hydro.laws.kernels import declared_law, law_flow_stress_cached
+
+RELATIVE_TOLERANCE = 1e-14
+MAX_ITERATIONS = 60
+
+
+@njit(cache=True, error_model="numpy")
+def bracketed_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta):
+    """The plastic strain increment d and the flow stress Y (Mbar) at the step's plastic rate d / dt for a trial
+    von Mises stress `equivalent` (Mbar) above the rate-free flow stress `rate_free` (Mbar), shear modulus G
+    (Mbar), step dt (us), at the cell's cached hardening `hard`, plastic strain eps_p, temperature T (K),
+    pressure P (Mbar) and density ratio eta (module docstring)."""
+    three_G = 3.0 * G
+    lo, hi = 0.0, (equivalent - rate_free) / three_G
+    d_prev = hi
+    Y_prev = law_flow_stress_cached(law, hard, G, eps_p, d_prev / dt, T, P, eta)
+    if Y_prev <= rate_free:      # the flow stress did not rise over the bracket: the rate-free return
+        return d_prev, rate_free
+    x_prev = math.log(d_prev)
+    d = hi * (equivalent - rate_free) / (Y_prev - rate_free + equivalent - rate_free)   # regula falsi on [0, hi]
+    for _ in range(MAX_ITERATIONS):
+        Y = law_flow_stress_cached(law, hard, G, eps_p, d / dt, T, P, eta)
+        r = equivalent - three_G * d - Y
+        if r == 0.0:
+            return d, Y
+        if r > 0.0:
+            lo = d
+        else:
+            hi = d
+        x = math.log(d)
+        slope = -three_G * d - (Y - Y_prev) / (x - x_prev)     # dr / d ln d, Y's slope a secant
+        candidate = d * math.exp(-r / slope)
+        if not lo < candidate < hi:
+            candidate = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
+        if abs(candidate - d) <= RELATIVE_TOLERANCE * d:
+            return d, Y
+        x_prev, Y_prev, d = x, Y, candidate
+    return d, law_flow_stress_cached(law, hard, G, eps_p, d / dt, T, P, eta)
+
+
+def law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta):
+    """The consistent return's (d, Y) for the law whose parameters `law` holds (arguments as in
+    `bracketed_plastic_increment`)."""
+    declared = declared_law(type(law))
+    if declared.plastic_increment is not None:
+        return declared.plastic_increment(law, equivalent, rate_free, G, dt)
+    if not declared.rate_dependent:
+        return (equivalent - rate_free) / (3.0 * G), rate_free
+    return bracketed_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+
+
+@overload(law_plastic_increment, jit_options={"cache": True})
+def _law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta):
+    declared = declared_law(law)
+    if declared.plastic_increment is not None:
+        kernel = declared.plastic_increment
+        return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: kernel(law, equivalent, rate_free,
+                                                                                         G, dt)
+    if not declared.rate_dependent:
+        return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: ((equivalent - rate_free) / (3.0 * G),
+                                                                                  rate_free)
+    return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: bracketed_plastic_increment(
+        law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
