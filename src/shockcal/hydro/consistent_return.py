@@ -13,13 +13,13 @@ implicit. The returned deviator is s = sign(s_trial) Y / (3/2), on the yield sur
 rate.
 
 `law_plastic_increment` picks, when numba compiles: the law's own solution where it declares one
-(`Law.plastic_increment`: Johnson-Cook's closed form), the radial return for a rate-free law
+(`Law.plastic_increment`: Johnson-Cook's and Zerilli-Armstrong's closed forms), the radial return for a rate-free law
 (Steinberg-Guinan, bit for bit as before), else `bracketed_plastic_increment`, which any law's kernel
 serves.
 
 `bracketed_plastic_increment`: the residual r(d) = 3/2 |s_trial| - 3 G d - Y(d) falls strictly with d (Y
 does not fall as the plastic rate grows). At d = 0 the plastic rate is 0, where each law reads its own limit
-(PTW's quasi-static r = 0; Zerilli-Armstrong's C0), so r(0) > 0 for a plastic trial; at the rate-free
+(PTW's quasi-static r = 0), so r(0) > 0 for a plastic trial; at the rate-free
 return's increment r <= 0. The root is bracketed there and found by Newton steps in ln d, where the rate
 terms are close to linear, the slope of Y a secant through the last two iterates (a law need not supply
 one); a step that leaves the bracket is replaced by a bisection (in ln d once the bracket's lower end is
@@ -78,7 +78,7 @@ def law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, 
     `bracketed_plastic_increment`)."""
     declared = declared_law(type(law))
     if declared.plastic_increment is not None:
-        return declared.plastic_increment(law, equivalent, rate_free, G, dt)
+        return declared.plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
     if not declared.rate_dependent:
         return (equivalent - rate_free) / (3.0 * G), rate_free
     return bracketed_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
@@ -90,7 +90,7 @@ def _law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P,
     if declared.plastic_increment is not None:
         kernel = declared.plastic_increment
         return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: kernel(law, equivalent, rate_free,
-                                                                                         G, dt)
+                                                                                         G, dt, hard, eps_p, T, P, eta)
     if not declared.rate_dependent:
         return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: ((equivalent - rate_free) / (3.0 * G),
                                                                                   rate_free)

@@ -44,6 +44,7 @@ from shockcal.hydro.laws.zerilli_armstrong import (
     ZerilliArmstrong,
     zerilli_armstrong_flow_stress,
     zerilli_armstrong_flow_stress_floor,
+    zerilli_armstrong_plastic_increment,
 )
 from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 
@@ -97,7 +98,8 @@ class Law:
     that cached hardening (for a law whose flow stress is its hardening times factors of rate and T).
     `rate_dependent`: whether the flow stress has a rate term, which the solver's return then evaluates at the
     step's plastic strain rate (`shockcal.hydro.consistent_return`); `plastic_increment(law, equivalent,
-    rate_free, G, dt)`, the law's own solution of that return (Johnson-Cook's closed form). A
+    rate_free, G, dt, hard, eps_p, T, P, eta)`, the law's own solution of that return (Johnson-Cook's and
+    Zerilli-Armstrong's closed forms). A
     study's design columns (`column`): the kernel's fields in code units for a law with `code_unit_columns`
     (Johnson-Cook, whose box a study gives in `inputs`), else the declared names in user units (a box in
     `strength.inputs` or config/models.yaml). `roles` names the parameters that study code reads by their
@@ -240,7 +242,7 @@ ZERILLI_ARMSTRONG = Law(
     ),
     ZerilliArmstrong, zerilli_armstrong_flow_stress,
     constraints=(("rate_ref_per_s > 0", lambda v: v["rate_ref_per_s"] > 0),),
-    flow_stress_floor=zerilli_armstrong_flow_stress_floor,
+    flow_stress_floor=zerilli_armstrong_flow_stress_floor, plastic_increment=zerilli_armstrong_plastic_increment,
 )
 
 LAWS: dict[str, Law] = {law.name: law for law in (JOHNSON_COOK, STEINBERG_GUINAN, PRESTON_TONKS_WALLACE,

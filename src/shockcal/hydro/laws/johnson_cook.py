@@ -103,11 +103,12 @@ def johnson_cook_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter,
 
 
 @njit(cache=True, error_model="numpy")
-def johnson_cook_plastic_increment(law, equivalent, rate_free, G, dt):
+def johnson_cook_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta):
     """The consistent return's plastic strain increment d and the flow stress Y (Mbar) at the step's plastic
     rate d / dt (module docstring), for a trial von Mises stress `equivalent` (Mbar) above the rate-free flow
-    stress `rate_free` (Mbar), shear modulus G (Mbar) and time step dt (us). Below the reference rate (or
-    with C <= 0) the rate-free radial return: d = (equivalent - rate_free) / (3 G), Y = rate_free."""
+    stress `rate_free` (Mbar), shear modulus G (Mbar) and time step dt (us); the cell's state (hard, eps_p,
+    T, P, eta) is in `rate_free` already. Below the reference rate (or with C <= 0) the rate-free radial
+    return: d = (equivalent - rate_free) / (3 G), Y = rate_free."""
     overstress = equivalent - rate_free
     d_free, d_ref = overstress / (3.0 * G), dt * law.rate_ref
     slope_x = rate_free * law.C                     # dY/dx
