@@ -6,8 +6,8 @@ structures (`EmulatorSpec.structure`, config `emulator.structure`):
 - `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
   G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
-A shot in `EmulatorSpec.own_blocks` (a new shot with runs of its own) gets a block of its own in either.
-A block's inputs derive from design columns by an `InputMap` (`shockcal.emulator.input_map`).
+A shot in `EmulatorSpec.own_blocks` (a new shot with runs of its own) gets a block of its own in either; a
+block's inputs derive from design columns by an `InputMap` (`shockcal.emulator.input_map`).
 
 Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units, settings,
 hyperparameters); loading rebuilds the Cholesky factors: small files, no live object pickled.
