@@ -1,16 +1,15 @@
 """The study's emulator of the calibration features: design columns mapped onto PC-GP emulators.
 
-`fit_emulator(design, features, spec)` joins each shot's features (`shockcal.velocimetry.features`) to the design
-on `run` and fits one array-level `PCGPEmulator` (`shockcal.emulator.pcgp`) per block, in one of two
-structures (`EmulatorSpec.structure`, config `emulator.structure`):
-- `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with
-  G_i the sum of its shear-modulus inputs (SPEC section 3); shots are independent.
+`fit_emulator(design, features, spec)` joins each shot's features (`shockcal.velocimetry.features`) to the design on `run` and
+fits one array-level `PCGPEmulator` (`shockcal.emulator.pcgp`) per block, in one of two structures (config `emulator.structure`):
+- `per_shot`: one emulator per shot over that shot's own inputs (A, B, C, n, m, V_i, G_i), with G_i the sum of its shear-modulus
+  inputs (SPEC section 3); shots are independent.
 - `joint`: the paper's single emulator of all shots' features over all inputs.
 A shot in `EmulatorSpec.own_blocks` (a new shot with runs of its own) gets a block of its own in either; a
 block's inputs derive from design columns by an `InputMap` (`shockcal.emulator.input_map`).
 
-Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units, settings,
-hyperparameters); loading rebuilds the Cholesky factors: small files, no live object pickled.
+Saved as `emulator.npz` (arrays) + `emulator.json` (format version, structure, names, units, settings, hyperparameters); loading
+rebuilds the Cholesky factors: small files, no live object pickled.
 """
 
 from __future__ import annotations
