@@ -6,6 +6,7 @@ import copy
 import json
 import re
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -144,6 +145,17 @@ def test_synthetic_truth_table_and_binomial_band(three_toy_trials):
     table = coverage_table(pd.concat([trials] * 34, ignore_index=True).assign(trial=np.repeat(np.arange(102), 3)))
     # 102 trials, nominal 0.9: the central 95% binomial band is 0.843-0.951
     assert table["band_low"].iloc[0] == pytest.approx(86 / 102) and table["band_high"].iloc[0] == pytest.approx(97 / 102)
+
+
+def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper_config):
+    """With `calibration.discrepancy` the truth has no discrepancy parameters to place in the posterior's joint
+    density: the trial's truth_hpd_mass is empty (the joint check is skipped), its per-parameter intervals are
+    there as without one."""
+    emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
+    settings = replace(_settings(paper_config, 100, 300), discrepancy={"kind": "feature_kind"})
+    trials = synthetic_truth(emu, ["toy"], settings, trials=1, seed=4)
+    assert (trials["status"] == "ok").all() and trials["truth_hpd_mass"].isna().all()
+    assert (trials["q05"] < trials["q95"]).all() and set(trials["parameter"]) == {*emu.required_inputs(["toy"]), "lambda_y"}
 
 
 def test_failed_trials_are_recorded_with_their_reason_not_the_end_of_the_batch(paper_config):

@@ -39,7 +39,8 @@ def synthetic_truth(emulator, shots, settings: CalibrationSettings, trials, seed
     `trial` and `run` columns. Columns:
     trial, run (the truth's hydrocode run; empty for emulator truth), parameter, truth, q05, q95, sd
     (posterior sd), inside (the 90% interval holds the truth), ess (Kish ESS),
-    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows), status ("ok" or
+    truth_hpd_mass (the trial's `hpd_mass` of the truth, the same on each of its rows; empty with a
+    `calibration.discrepancy`, whose parameters the truth does not have: the intervals are the check), status ("ok" or
     "failed") and reason. A trial that fails (the sampler at `max_evaluations`, no positive noise draw)
     is recorded with its reason and empty results, and the next one runs; the coverage leaves it out
     (`usable_trials`) and counts it.
@@ -90,9 +91,12 @@ def _trial_rows(emulator, shots, names, settings: CalibrationSettings, trial, rn
     draws_table, summary = posterior.draws, posterior.summary(native=True).set_index("parameter")
     if draws is not None:
         draws.append(draws_table.assign(trial=trial, run=run))
-    problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)
-    truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
-    mass = hpd_mass(log_density(draws_table["log_likelihood"], draws_table[LAMBDA_Y]), log_density(truth_ll, lam))
+    if settings.discrepancy == "none":
+        problem = Problem.for_shots(emulator, shots, observed, settings.sd_fraction)
+        truth_ll = problem.log_likelihood(np.append(theta, lam)[None])[0]
+        mass = hpd_mass(log_density(draws_table["log_likelihood"], draws_table[LAMBDA_Y]), log_density(truth_ll, lam))
+    else:       # the truth has no discrepancy parameters to place in the posterior's joint density
+        mass = float("nan")
     rows = []
     for name, truth in [*zip(names, theta), (LAMBDA_Y, lam)]:
         q05, q95 = summary.loc[name, ["q05", "q95"]]
