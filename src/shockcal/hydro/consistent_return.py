@@ -17,6 +17,10 @@ rate.
 (Steinberg-Guinan, bit for bit as before), else `bracketed_plastic_increment`, which any law's kernel
 serves.
 
+`law_plastic_increment_warm` is the same with the cell's warm start (x_warm, rate_warm: the law's solve
+variable and the plastic rate, 1/us, at the cell's last plastic step) in and renewed, for a law that declares
+`plastic_increment_warm` (Johnson-Cook); other laws pass it through.
+
 `bracketed_plastic_increment`: the residual r(d) = 3/2 |s_trial| - 3 G d - Y(d) falls strictly with d (Y
 does not fall as the plastic rate grows). At d = 0 the plastic rate is 0, where each law reads its own limit
 (PTW's quasi-static r = 0), so r(0) > 0 for a plastic trial; at the rate-free
@@ -96,3 +100,26 @@ def _law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P,
                                                                                   rate_free)
     return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: bracketed_plastic_increment(
         law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+
+
+def law_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+    """`law_plastic_increment`'s (d, Y) and the cell's renewed warm start (x, rate, 1/us): from the law's
+    `plastic_increment_warm` where it declares one, else the warm start (x_warm, rate_warm) unchanged."""
+    kernel = declared_law(type(law)).plastic_increment_warm
+    if kernel is not None:
+        return kernel(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm)
+    d, Y = law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+    return d, Y, x_warm, rate_warm
+
+
+@overload(law_plastic_increment_warm, jit_options={"cache": True})
+def _law_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+    kernel = declared_law(law).plastic_increment_warm
+    if kernel is not None:
+        return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm: kernel(
+            law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm)
+
+    def cold(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+        d, Y = law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+        return d, Y, x_warm, rate_warm
+    return cold
