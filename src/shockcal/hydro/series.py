@@ -17,25 +17,30 @@ from numba import njit
 REMAINDER = 1e-17          # the first omitted term of a series, relative: a tenth of the rounding of 1
 EXP_STEP_MAX = 1e-2        # |s| up to which e^s's series to s^6 holds: s^7 / 7! = 2e-18
 NO_SERIES = -2.0           # what `power_growth` returns where its series does not hold ((1 + u)^m - 1 > -1)
+INVERSE_INTEGER = (1.0, 1.0, 0.5, 1.0 / 3.0, 0.25, 0.2, 1.0 / 6.0)             # 1/k: multiplied, not divided
+INVERSE_FACTORIAL = (1.0, 1.0, 0.5, 1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0, 1.0 / 720.0)   # 1/k!
 
 
 @njit(cache=True, error_model="numpy")
 def exp_small(s):
-    """e^s (|s| <= EXP_STEP_MAX) by its Taylor series to s^6."""
-    return 1.0 + s * (1.0 + s / 2.0 * (1.0 + s / 3.0 * (1.0 + s / 4.0 * (1.0 + s / 5.0 * (1.0 + s / 6.0)))))
+    """e^s (|s| <= EXP_STEP_MAX) by its Taylor series to s^6, grouped in powers of s^2 (Estrin's scheme: a
+    short chain of dependent operations, which is what a plastic cell's solve waits on)."""
+    s2 = s * s
+    return (1.0 + s) + s2 * ((INVERSE_FACTORIAL[2] + s * INVERSE_FACTORIAL[3])
+                             + s2 * ((INVERSE_FACTORIAL[4] + s * INVERSE_FACTORIAL[5]) + s2 * INVERSE_FACTORIAL[6]))
 
 
 @njit(cache=True, error_model="numpy")
 def power_growth(u, m):
     """(1 + u)^m - 1 by the binomial series to u^5, or NO_SERIES where its first omitted term,
-    binom(m, 6) u^6, would exceed REMAINDER (the caller then evaluates the power)."""
-    c1 = m
-    c2 = c1 * (m - 1.0) / 2.0
-    c3 = c2 * (m - 2.0) / 3.0
-    c4 = c3 * (m - 3.0) / 4.0
-    c5 = c4 * (m - 4.0) / 5.0
-    c6 = c5 * (m - 5.0) / 6.0
+    binom(m, 6) u^6, would exceed REMAINDER (the caller then evaluates the power). Grouped as `exp_small`."""
+    c2 = m * (m - 1.0) * INVERSE_INTEGER[2]
+    c3 = c2 * (m - 2.0) * INVERSE_INTEGER[3]
+    c4 = c3 * (m - 3.0) * INVERSE_INTEGER[4]
+    c5 = c4 * (m - 4.0) * INVERSE_INTEGER[5]
+    c6 = c5 * (m - 5.0) * INVERSE_INTEGER[6]
     u2 = u * u
-    if not abs(c6) * u2 * u2 * u2 <= REMAINDER:
+    u4 = u2 * u2
+    if not abs(c6) * u4 * u2 <= REMAINDER:
         return NO_SERIES
-    return u * (c1 + u * (c2 + u * (c3 + u * (c4 + u * c5))))
+    return (m * u + u2 * (c2 + u * c3)) + u4 * (c4 + u * c5)
