@@ -30,11 +30,12 @@ from shockcal.hydro.laws.kernels import (
 )
 
 LAW_FLOOR_SLACK = 1.0 - 1e-9  # keeps a law's floor below its flow stress, computed along another path
+NO_MEMORY = (0.0, 0.0, 0.0, 0.0)  # a fresh cell's (power_T, power, x_warm, rate_warm): nothing to reuse yet
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def plastic_return(s_trial, T_cell, dt, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, memory, strength,
-                   material):
+def plastic_return(s_trial, T_cell, dt, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength, material,
+                   memory):
     """A cell's return after its elastic trial deviator s_trial (Mbar) over a step dt (us), on scalars: (s,
     d eps_p, and the cell's new eps_p, hard, flow_floor, floor_hotter, floor_T, memory). Elastic while the trial
     lies inside the law's floor (from the cell's cached hardening `hard`, its remembered floor in the flow_floor,
@@ -42,7 +43,7 @@ def plastic_return(s_trial, T_cell, dt, P, eta, G, eps_p, hard, flow_floor, floo
     temperature (K), pressure (Mbar), density ratio and shear modulus G (Mbar); else the consistent return
     onto the flow stress at the step's plastic rate. `hard` follows the plastic strain (`law_hardening_after`); an
     elastic full evaluation sets the remembered floor (`law_remember_floor`). `memory` = (power_T, power,
-    x_warm, rate_warm) is what a cell that stays plastic reuses (`state.Cells`): the law's thermal power at a
+    x_warm, rate_warm) is what a cell that stays plastic reuses (`state.Cells`; NO_MEMORY: none yet): the law's thermal power at a
     temperature (`law_rate_free_flow_stress`) and the warm start of its solve (`law_plastic_increment_warm`). A
     cell with G = 0 (molten) carries no deviator and gains no plastic strain. `material` is not used (the law's
     tuple holds its material constants). Scalars in and out: inlined code that indexes the cell arrays cost the

@@ -195,7 +195,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         s_trial = s[j] + four_thirds_G * strain_rate * dt
         s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j], memory = plastic_return(
             s_trial, T_cell, dt, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
-            (power_T[j], power[j], x_warm[j], rate_warm[j]), strength, material)
+            strength, material, (power_T[j], power[j], x_warm[j], rate_warm[j]))
         power_T[j], power[j], x_warm[j], rate_warm[j] = memory
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
