@@ -39,6 +39,10 @@ FLOOR_SLACK = 1.0 - 1e-12  # keeps the remembered thermal factor below the exact
 STEP_STOP = 1e-6           # a Halley step in x = ln(d / d_ref) this small leaves an error about 1e-18 (cubic)
 NEWTON_MAX_STEPS = 60
 RATE_FREE = 0.0           # the plastic strain rate (1/us) of the rate-free yield surface
+# Without a rate term (C = 0) the return is the rate-free radial return, whose switching between
+# yield and no yield carries a last-bit change of the flow stress into the trace (1e-6 m/s where a
+# rate-dependent run moves 1e-11 m/s): there the series are not used, and such runs keep the radial return's
+# arithmetic bit for bit (tests/test_hydro.py's C = 0 traces stored before the rate term moved into the return).
 
 
 class JohnsonCook(NamedTuple):
@@ -109,9 +113,10 @@ def johnson_cook_rate_free_flow_stress(law, hard, T, power_T, power):
     """The flow stress (Mbar) at zero plastic rate, `johnson_cook_flow_stress_from_hardening` at rate 0, from the
     cell's cached hardening `hard` (Mbar) at T (K), with T*^m from the cell's remembered `power` = T*^m at
     `power_T` (K) by the binomial series (`series.power_growth`) where it holds, else by the pow: (Y0, T, the
-    new T*^m); at T* outside (0, 1) or m = 0 the thermal factor's own conventions, the memory unchanged."""
+    new T*^m); at T* outside (0, 1) or m = 0 the thermal factor's own conventions, the memory unchanged; without a
+    rate term (C <= 0) the pow always (the note at RATE_FREE)."""
     homologous = _homologous(law, T)
-    if homologous <= 0.0 or homologous >= 1.0 or law.m == 0.0:
+    if homologous <= 0.0 or homologous >= 1.0 or law.m == 0.0 or law.C <= 0.0:
         return hard * rate_factor(law.C, RATE_FREE, law.rate_ref) * thermal_factor(law.m, homologous), power_T, power
     growth = power_growth((T - power_T) / (power_T - law.T_ref), law.m) if power > 0.0 else NO_SERIES
     power = homologous**law.m if growth == NO_SERIES else power + power * growth
@@ -121,8 +126,9 @@ def johnson_cook_rate_free_flow_stress(law, hard, T, power_T, power):
 @njit(cache=True, error_model="numpy")
 def johnson_cook_hardening_after(law, hard, eps_p, d_eps):
     """A + B (eps_p + d_eps)^n (Mbar) from the cell's hard = A + B eps_p^n: hard + (hard - A) ((1 + d_eps /
-    eps_p)^n - 1) by the binomial series (`series.power_growth`) where it holds, else `johnson_cook_hardening`."""
-    growth = power_growth(d_eps / eps_p, law.n) if eps_p > 0.0 else NO_SERIES
+    eps_p)^n - 1) by the binomial series (`series.power_growth`) where it holds, else `johnson_cook_hardening`
+    (always without a rate term, C <= 0: the note at RATE_FREE)."""
+    growth = power_growth(d_eps / eps_p, law.n) if eps_p > 0.0 and law.C > 0.0 else NO_SERIES
     if growth == NO_SERIES:
         return johnson_cook_hardening(law, eps_p + d_eps)
     return hard + (hard - law.A) * growth
