@@ -96,7 +96,7 @@ def _start(src: Path, laws: bool) -> tuple[subprocess.Popen, list[str]]:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("trees", nargs="+", help="LABEL=SRC: a source tree's src/ under a label")
+    parser.add_argument("trees", nargs="*", help="LABEL=SRC: a source tree's src/ under a label")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--laws", action="store_true", help="also a thin run per strength law")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
@@ -105,7 +105,7 @@ def main(argv=None) -> None:
         child(args.laws)
         return
     trees = [tree.split("=", 1) for tree in args.trees]
-    if any(len(tree) != 2 for tree in trees):
+    if not trees or any(len(tree) != 2 for tree in trees):
         sys.exit("bench_hydro_trees.py: give each tree as LABEL=SRC")
     print(f"load average at start: {os.getloadavg()[0]:.2f} (CPU seconds are inflated when > 0)", flush=True)
     children = {label: _start(Path(src), args.laws) for label, src in trees}
