@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 
 from shockcal.hydro import ShotParameters, run_shot
 from shockcal.hydro.laws.johnson_cook import JohnsonCook
-from shockcal.hydro.plastic_return import initial_hardening, plastic_return
+from shockcal.hydro.plastic_return import NO_MEMORY, initial_hardening, plastic_return
 from shockcal.hydro.state import LawStrength
 from shockcal.hydro.strength import hardening, rate_factor, thermal_factor, thermal_factor_below
 from shockcal.study.adapters import hydro_inputs
@@ -155,7 +155,8 @@ def test_strength_conventions():
     assert thermal_factor(0.0, 0.0) == 1.0
     assert thermal_factor(2.0, 0.5) == pytest.approx(0.75)
     rate_free = LawStrength(JohnsonCook(0.003, 0.0, 0.0, 0.0, 1.0, 298.0, 893.0, 1e-6), G)   # Y = 0.003 Mbar
-    cell = (298.0, 1e-3, 0.0, 1.0, G, 0.0, initial_hardening(rate_free), 0.0, 0.0, math.inf, rate_free, None)
+    cell = (298.0, 1e-3, 0.0, 1.0, G, 0.0, initial_hardening(rate_free), 0.0, 0.0, math.inf, rate_free, None,
+            NO_MEMORY)
     s, d_eps = plastic_return(-0.004, *cell)[:2]                          # 1.5 * 0.004 = 0.006 > 0.003
     assert 1.5 * abs(s) == pytest.approx(0.003) and s < 0
     assert d_eps == pytest.approx(0.003 / (3 * G))

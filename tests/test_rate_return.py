@@ -18,7 +18,7 @@ from shockcal.hydro.laws.johnson_cook import JohnsonCook
 from shockcal.hydro.laws.kernels import law_hardening
 from shockcal.hydro.laws.zerilli_armstrong import ZerilliArmstrong
 from shockcal.hydro.material_library import load_material
-from shockcal.hydro.plastic_return import cell_shear_modulus, initial_hardening, plastic_return
+from shockcal.hydro.plastic_return import NO_MEMORY, cell_shear_modulus, initial_hardening, plastic_return
 from shockcal.hydro.state import LawStrength
 from shockcal.study.adapters import extractor_settings, hydro_inputs
 from shockcal.study.config import shot_config
@@ -37,13 +37,13 @@ def strain_cell(strength, strain_rate_xx, dt, steps, T, P, eta):
     before the step, and the cell's G (Mbar)."""
     G = cell_shear_modulus(strength, P, T, eta)
     s, eps_p, hard = 0.0, 0.0, initial_hardening(strength)
-    flow_floor, floor_hotter, floor_T = 0.0, 0.0, np.inf
+    flow_floor, floor_hotter, floor_T, memory = 0.0, 0.0, np.inf, NO_MEMORY
     flows, increments, strains = np.empty(steps), np.empty(steps), np.empty(steps)
     for k in range(steps):
         strains[k] = eps_p
         s_trial = s + 4.0 * G / 3.0 * strain_rate_xx * dt
-        s, d_eps, eps_p, hard, flow_floor, floor_hotter, floor_T = plastic_return(
-            s_trial, T, dt, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength, None)
+        s, d_eps, eps_p, hard, flow_floor, floor_hotter, floor_T, memory = plastic_return(
+            s_trial, T, dt, P, eta, G, eps_p, hard, flow_floor, floor_hotter, floor_T, strength, None, memory)
         flows[k], increments[k] = 1.5 * abs(s), d_eps
     return flows, increments, strains, G
 

@@ -17,6 +17,11 @@ rate.
 (Steinberg-Guinan, bit for bit as before), else `bracketed_plastic_increment`, which any law's kernel
 serves.
 
+`law_plastic_increment_warm` is the same with the cell's warm start (x_warm, rate_warm: the law's solve
+variable and the plastic rate, 1/us, at the cell's last plastic step) in and renewed, for a law that declares
+`plastic_increment_warm` (Johnson-Cook: x = ln(rate / epsdot_0)) and for the bracketed iteration (x_warm: the
+secant slope dY / d ln d, Mbar, `bracketed_plastic_increment_warm`); other laws pass it through.
+
 `bracketed_plastic_increment`: the residual r(d) = 3/2 |s_trial| - 3 G d - Y(d) falls strictly with d (Y
 does not fall as the plastic rate grows). At d = 0 the plastic rate is 0, where each law reads its own limit
 (PTW's quasi-static r = 0), so r(0) > 0 for a plastic trial; at the rate-free
@@ -44,33 +49,58 @@ def bracketed_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, 
     """The plastic strain increment d and the flow stress Y (Mbar) at the step's plastic rate d / dt for a trial
     von Mises stress `equivalent` (Mbar) above the rate-free flow stress `rate_free` (Mbar), shear modulus G
     (Mbar), step dt (us), at the cell's cached hardening `hard`, plastic strain eps_p, temperature T (K),
-    pressure P (Mbar) and density ratio eta (module docstring)."""
+    pressure P (Mbar) and density ratio eta (module docstring); without a warm start."""
+    d, Y, _, _ = bracketed_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, 0.0, 0.0)
+    return d, Y
+
+
+@njit(cache=True, error_model="numpy")
+def bracketed_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, slope_warm,
+                                     rate_warm):
+    """`bracketed_plastic_increment`'s (d, Y) and the cell's renewed warm start (the secant slope dY / d ln d,
+    Mbar, and the plastic rate d / dt, 1/us, at the solution). With a warm start (rate_warm, 1/us, inside the
+    bracket and slope_warm > 0) the iteration starts at d = rate_warm dt with a Newton step on the remembered
+    slope, the bracket [0, rate-free increment] kept; else at the bracket's upper end, as without one."""
     three_G = 3.0 * G
     lo, hi = 0.0, (equivalent - rate_free) / three_G
-    d_prev = hi
+    d_prev, warm = rate_warm * dt, rate_warm > 0.0 and slope_warm > 0.0
+    if not (warm and d_prev < hi):
+        d_prev, warm = hi, False
     Y_prev = law_flow_stress_cached(law, hard, G, eps_p, d_prev / dt, T, P, eta)
-    if Y_prev <= rate_free:      # the flow stress did not rise over the bracket: the rate-free return
-        return d_prev, rate_free
+    if warm:
+        r = equivalent - three_G * d_prev - Y_prev
+        if r > 0.0:
+            lo = d_prev
+        else:
+            hi = d_prev
+        d = d_prev * math.exp(r / (three_G * d_prev + slope_warm))       # Newton in ln d, the remembered slope
+        if not lo < d < hi:
+            d = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
+        if abs(d - d_prev) <= RELATIVE_TOLERANCE * d_prev:             # the warm start is the solution
+            return d_prev, Y_prev, slope_warm, rate_warm
+    elif Y_prev <= rate_free:    # the flow stress did not rise over the bracket: the rate-free return
+        return d_prev, rate_free, slope_warm, rate_warm
+    else:
+        d = hi * (equivalent - rate_free) / (Y_prev - rate_free + equivalent - rate_free)   # regula falsi on [0, hi]
     x_prev = math.log(d_prev)
-    d = hi * (equivalent - rate_free) / (Y_prev - rate_free + equivalent - rate_free)   # regula falsi on [0, hi]
     for _ in range(MAX_ITERATIONS):
         Y = law_flow_stress_cached(law, hard, G, eps_p, d / dt, T, P, eta)
         r = equivalent - three_G * d - Y
+        x = math.log(d)
+        secant = (Y - Y_prev) / (x - x_prev)                    # Y's slope in ln d
         if r == 0.0:
-            return d, Y
+            return d, Y, secant, d / dt
         if r > 0.0:
             lo = d
         else:
             hi = d
-        x = math.log(d)
-        slope = -three_G * d - (Y - Y_prev) / (x - x_prev)     # dr / d ln d, Y's slope a secant
-        candidate = d * math.exp(-r / slope)
+        candidate = d * math.exp(r / (three_G * d + secant))    # Newton in ln d: dr / d ln d = -(3 G d + secant)
         if not lo < candidate < hi:
             candidate = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
         if abs(candidate - d) <= RELATIVE_TOLERANCE * d:
-            return d, Y
+            return d, Y, secant, d / dt
         x_prev, Y_prev, d = x, Y, candidate
-    return d, law_flow_stress_cached(law, hard, G, eps_p, d / dt, T, P, eta)
+    return d, law_flow_stress_cached(law, hard, G, eps_p, d / dt, T, P, eta), slope_warm, rate_warm
 
 
 def law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta):
@@ -96,3 +126,33 @@ def _law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P,
                                                                                   rate_free)
     return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta: bracketed_plastic_increment(
         law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+
+
+def law_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+    """`law_plastic_increment`'s (d, Y) and the cell's renewed warm start (x, rate, 1/us): from the law's
+    `plastic_increment_warm` where it declares one, else the warm start (x_warm, rate_warm) unchanged."""
+    declared = declared_law(type(law))
+    if declared.plastic_increment_warm is not None:
+        return declared.plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm,
+                                               rate_warm)
+    if declared.rate_dependent and declared.plastic_increment is None:
+        return bracketed_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm,
+                                                rate_warm)
+    d, Y = law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+    return d, Y, x_warm, rate_warm
+
+
+@overload(law_plastic_increment_warm, jit_options={"cache": True})
+def _law_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+    declared = declared_law(law)
+    kernel = declared.plastic_increment_warm
+    if kernel is None and declared.rate_dependent and declared.plastic_increment is None:
+        kernel = bracketed_plastic_increment_warm
+    if kernel is not None:
+        return lambda law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm: kernel(
+            law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm)
+
+    def cold(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm):
+        d, Y = law_plastic_increment(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta)
+        return d, Y, x_warm, rate_warm
+    return cold

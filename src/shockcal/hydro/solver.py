@@ -77,7 +77,8 @@ def initial_mesh(nf, nt, dx, velocity, initial, strength, material):
     E[gap] = 0.0
     hard = np.full(N + 1, initial_hardening(strength))
     cells = Cells(mass, length, E, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1),
-                  np.zeros(N + 1), hard, np.zeros(N + 1), np.zeros(N + 1), np.full(N + 1, np.inf))
+                  np.zeros(N + 1), hard, np.zeros(N + 1), np.zeros(N + 1), np.full(N + 1, np.inf), np.zeros(N + 1),
+                  np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1))
     u = np.zeros(N + 2)
     u[: nf + 1] = velocity
     node_mass = np.empty(N + 2)
@@ -169,6 +170,7 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
     mass, length, E, P, s, sigma = cells.mass, cells.length, cells.E, cells.P, cells.s, cells.sigma
     eps_p, hard, flow_floor, floor_hotter, floor_T = (cells.eps_p, cells.hard, cells.flow_floor, cells.floor_hotter,
                                                       cells.floor_T)
+    power_T, power, x_warm, rate_warm = cells.power_T, cells.power, cells.x_warm, cells.rate_warm
     N = E.shape[0] - 1
     g_rho0 = material.gamma0 * material.rho0
     max_signal_rate = numerics.cfl / numerics.dt_max
@@ -191,9 +193,10 @@ def update_cells(nodes, cells, gap, lo, hi, dt, strength, material, numerics, pe
         c_long = math.sqrt(max(c_bulk_sq, 0.0) + four_thirds_G * volume)
         q = artificial_viscosity(du, volume, c_long, numerics.q1, numerics.q2)
         s_trial = s[j] + four_thirds_G * strain_rate * dt
-        s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j] = plastic_return(
+        s_new, d_eps, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j], memory = plastic_return(
             s_trial, T_cell, dt, P[j], eta, G, eps_p[j], hard[j], flow_floor[j], floor_hotter[j], floor_T[j],
-            strength, material)
+            strength, material, (power_T[j], power[j], x_warm[j], rate_warm[j]))
+        power_T[j], power[j], x_warm[j], rate_warm[j] = memory
         dV = dt * du / mass[j]
         work_dev = 0.5 * (s[j] + s_new) * strain_rate * dt * volume
         p_cold = cold_pressure(mu, material.c1, material.c2, material.c3)

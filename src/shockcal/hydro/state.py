@@ -87,7 +87,10 @@ class Cells(NamedTuple):
     `floor_T`) the floor the law remembers, in the law's meaning (`plastic_return.plastic_return`;
     Johnson-Cook: the thermal factor 1 - T*^m at floor_T, K, and a lower bound of it
     `laws.johnson_cook.FLOOR_MARGIN_K` hotter; PTW: tau^, the sixth power of the lowest rate ratio and the
-    highest temperature it holds for). A trial stress inside the floor is elastic without evaluating the law."""
+    highest temperature it holds for). A trial stress inside the floor is elastic without evaluating the law.
+    `power_T`, `power`, `x_warm` and `rate_warm` are what a cell that stays plastic reuses, in the law's meaning
+    (Johnson-Cook: T*^m at power_T, K, and the solve's x = ln(rate / epsdot_0) and the plastic rate, 1/us, of
+    the cell's last plastic step; power = 0 and rate_warm = 0: none yet; `shockcal.hydro.series`)."""
 
     mass: np.ndarray       # g/cm^2
     length: np.ndarray     # cm
@@ -100,3 +103,7 @@ class Cells(NamedTuple):
     flow_floor: np.ndarray  # Mbar
     floor_hotter: np.ndarray  # Mbar
     floor_T: np.ndarray    # K
+    power_T: np.ndarray    # K
+    power: np.ndarray      # -
+    x_warm: np.ndarray     # -
+    rate_warm: np.ndarray  # 1/us

@@ -20,7 +20,10 @@ from shockcal.hydro.laws.johnson_cook import (
     johnson_cook_flow_stress_floor,
     johnson_cook_flow_stress_from_hardening,
     johnson_cook_hardening,
+    johnson_cook_hardening_after,
     johnson_cook_plastic_increment,
+    johnson_cook_plastic_increment_warm,
+    johnson_cook_rate_free_flow_stress,
     johnson_cook_remember_floor,
 )
 from shockcal.hydro.laws.preston_tonks_wallace import (
@@ -99,7 +102,12 @@ class Law:
     `rate_dependent`: whether the flow stress has a rate term, which the solver's return then evaluates at the
     step's plastic strain rate (`shockcal.hydro.consistent_return`); `plastic_increment(law, equivalent,
     rate_free, G, dt, hard, eps_p, T, P, eta)`, the law's own solution of that return (Johnson-Cook's and
-    Zerilli-Armstrong's closed forms). A
+    Zerilli-Armstrong's closed forms). Kernels that spare a cell that stays plastic its pows and logs, each the
+    same value to rounding (`shockcal.hydro.series`): `hardening_after(law, hard, eps_p, d_eps)`, the hardening
+    after an increment from the cached one; `rate_free_flow_stress(law, hard, T, power_T, power)`, the flow
+    stress at zero rate from a thermal power the cell remembers, with the renewed memory;
+    `plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, eps_p, T, P, eta, x_warm, rate_warm)`,
+    `plastic_increment` started at the cell's last plastic rate, with the renewed warm start. A
     study's design columns (`column`): the kernel's fields in code units for a law with `code_unit_columns`
     (Johnson-Cook, whose box a study gives in `inputs`), else the declared names in user units (a box in
     `strength.inputs` or config/models.yaml). `roles` names the parameters that study code reads by their
@@ -122,6 +130,9 @@ class Law:
     flow_stress_from_hardening: Callable | None = None
     rate_dependent: bool = True
     plastic_increment: Callable | None = None
+    hardening_after: Callable | None = None
+    rate_free_flow_stress: Callable | None = None
+    plastic_increment_warm: Callable | None = None
     code_unit_columns: bool = False
     roles: Mapping[str, str] = field(default_factory=dict)
 
@@ -167,7 +178,9 @@ JOHNSON_COOK = Law(
     melt_temperature=lambda law, eta: law.T_melt,
     hardening=johnson_cook_hardening, flow_stress_floor=johnson_cook_flow_stress_floor,
     remember_floor=johnson_cook_remember_floor, flow_stress_from_hardening=johnson_cook_flow_stress_from_hardening,
-    plastic_increment=johnson_cook_plastic_increment,
+    plastic_increment=johnson_cook_plastic_increment, hardening_after=johnson_cook_hardening_after,
+    rate_free_flow_stress=johnson_cook_rate_free_flow_stress,
+    plastic_increment_warm=johnson_cook_plastic_increment_warm,
     code_unit_columns=True,
     roles={"yield_stress": "A_MPa", "rate_coefficient": "C", "hardening_exponent": "n", "thermal_exponent": "m"},
 )

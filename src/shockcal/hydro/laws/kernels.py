@@ -9,6 +9,11 @@ compiles (no run-time branch, no function objects passed around, so callers stay
     law_flow_stress_cached(law, hard, G, eps_p, strain_rate, T, P, eta) -> Mbar   (law_flow_stress_at, from the
                                                       cell's cached hardening `hard` where the law can use it)
     law_hardening(law, eps_p) -> the law's cached hardening (0 for laws without one)
+    law_hardening_after(law, hard, eps_p, d_eps) -> law_hardening(law, eps_p + d_eps), from the cached `hard`
+                                                      where the law can (Johnson-Cook: a series, no pow)
+    law_rate_free_flow_stress(law, hard, G, eps_p, T, P, eta, power_T, power)
+        -> (law_flow_stress_cached at zero strain rate, power_T, power): the cell's remembered thermal power
+           (Johnson-Cook: T*^m at power_T, K) read and renewed by a law that keeps one, else passed through
     law_flow_stress_floor(law, hard, G, T, eta, flow_floor, floor_hotter, floor_T) -> Mbar
         (a proven lower bound of the flow stress at any strain rate from the cell's cached hardening and
          remembered floor, -1 where the law has none)
@@ -147,3 +152,37 @@ def _law_remember_floor(law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T
         return lambda law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T: (flow_floor, floor_hotter, floor_T)
     return lambda law, G, eps_p, T, eta, flow_floor, floor_hotter, floor_T: kernel(law, G, eps_p, T, eta, flow_floor,
                                                                                    floor_hotter, floor_T)
+
+
+def law_hardening_after(law, hard, eps_p, d_eps):
+    """`law_hardening(law, eps_p + d_eps)` after a plastic increment d_eps from the cell's `hard` at eps_p, by a
+    law that declares `hardening_after` (the same value to rounding), else evaluated afresh."""
+    kernel = declared_law(type(law)).hardening_after
+    return law_hardening(law, eps_p + d_eps) if kernel is None else kernel(law, hard, eps_p, d_eps)
+
+
+def law_rate_free_flow_stress(law, hard, G, eps_p, T, P, eta, power_T, power):
+    """The flow stress (Mbar) at zero plastic rate (`law_flow_stress_cached`), and the cell's remembered thermal
+    power (power_T K, power) renewed by a law that declares `rate_free_flow_stress` (the same value to
+    rounding), else passed through."""
+    kernel = declared_law(type(law)).rate_free_flow_stress
+    if kernel is None:
+        return law_flow_stress_cached(law, hard, G, eps_p, 0.0, T, P, eta), power_T, power
+    return kernel(law, hard, T, power_T, power)
+
+
+@overload(law_hardening_after, jit_options={"cache": True})
+def _law_hardening_after(law, hard, eps_p, d_eps):
+    kernel = declared_law(law).hardening_after
+    if kernel is None:
+        return lambda law, hard, eps_p, d_eps: law_hardening(law, eps_p + d_eps)
+    return lambda law, hard, eps_p, d_eps: kernel(law, hard, eps_p, d_eps)
+
+
+@overload(law_rate_free_flow_stress, jit_options={"cache": True})
+def _law_rate_free_flow_stress(law, hard, G, eps_p, T, P, eta, power_T, power):
+    kernel = declared_law(law).rate_free_flow_stress
+    if kernel is None:
+        return lambda law, hard, G, eps_p, T, P, eta, power_T, power: (
+            law_flow_stress_cached(law, hard, G, eps_p, 0.0, T, P, eta), power_T, power)
+    return lambda law, hard, G, eps_p, T, P, eta, power_T, power: kernel(law, hard, T, power_T, power)
