@@ -190,7 +190,7 @@ def calibration_settings(config: dict, shots, check: bool = False) -> Calibratio
                                velocity_boxes={shot: box for shot, box in boxes.items() if box is not None},
                                check_plateau=config["checks"]["plateau_vs_velocity"],
                                check_training_range=config["checks"]["features_in_training_range"] and not check,
-                               discrepancy=config["calibration"].get("discrepancy", "none"))
+                               discrepancy=config["calibration"]["discrepancy"])
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False

@@ -68,11 +68,12 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the emulator's predictions at a design's runs
     "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # one calibration (single shot or joint)
-    "calibrate": ("study.seed", *_SAMPLER, "observed.sd_fraction", "checks.observed_units", "checks.plateau_vs_velocity",
-                  "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
+    "calibrate": ("study.seed", *_SAMPLER, "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
+                  "checks.plateau_vs_velocity", "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a batch of synthetic-truth trials
     "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
-                        "observed.sd_fraction", "checks.observed_units", "checks.plateau_vs_velocity",
+                        "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
+                        "checks.plateau_vs_velocity",
                         "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
     "wave_design": ("study.seed", "design.strategy", "design.waves", "observed.sd_fraction", "inputs",
