@@ -6,7 +6,6 @@ import copy
 import json
 import re
 import warnings
-from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -152,7 +151,7 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
     density: the trial's truth_hpd_mass is empty (the joint check is skipped), its per-parameter intervals are
     there as without one."""
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    settings = replace(_settings(paper_config, 100, 300), discrepancy={"kind": "feature_kind"})
+    settings = _settings(paper_config, 100, 300).replace(discrepancy={"kind": "feature_kind"})
     trials = synthetic_truth(emu, ["toy"], settings, trials=1, seed=4)
     assert (trials["status"] == "ok").all() and trials["truth_hpd_mass"].isna().all()
     assert (trials["q05"] < trials["q95"]).all() and set(trials["parameter"]) == {*emu.required_inputs(["toy"]), "lambda_y"}
@@ -160,7 +159,7 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
 
 def test_failed_trials_are_recorded_with_their_reason_not_the_end_of_the_batch(paper_config):
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    starved = _settings(paper_config, 100, 300).with_sampler(max_evaluations=50)
+    starved = _settings(paper_config, 100, 3000).with_sampler(max_evaluations=1000)     # the least the config takes
     trials = synthetic_truth(emu, ["toy"], starved, trials=2, seed=4)
     assert len(trials) == 2 * 3 and sorted(trials["trial"].unique()) == [0, 1]
     assert (trials["status"] == "failed").all() and trials["reason"].str.contains("max_evaluations").all()
@@ -429,8 +428,10 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     box = small_config["inputs"]["V1"]                      # the velocity's quantiles in m/s, inside its box
     assert 1e4 * box["min"] <= summary.loc["V1_m_s", "q05"] <= summary.loc["V1_m_s", "q95"] <= 1e4 * box["max"]
 
-    for option, value, message in [("--n-live", "10", "--n-live: n_live 10: at least 50 live points"),
-                                   ("--n-eff", "20", "--n-eff: n_eff 20: at least 100")]:
+    for option, value, message in [("--n-live", "10", "--n-live: SamplerSettings.n_live 10: Input should be greater "
+                                                       "than or equal to 50"),
+                                   ("--n-eff", "20", "--n-eff: SamplerSettings.n_eff 20: Input should be greater than "
+                                                     "or equal to 100")]:
         assert main([*args, option, value]) == 2                          # refused before any sampling, in one line
         err = capsys.readouterr().err.strip()
         assert message in err and "\n" not in err, err
@@ -465,10 +466,8 @@ def test_check_cli_names_what_is_missing_in_the_hydrocode_truth(extra, message, 
 def test_every_sampler_setting_in_the_schema_has_the_librarys_minimum():
     """One set of rules behind both doors: each n_live and n_eff the config takes (the calibration, its
     check, the next-shot check, a sequential study's steps) has the minimum SamplerSettings refuses below."""
-    import yaml
-
-    from shockcal.inference.sampler import MIN_N_EFF, MIN_N_LIVE
-    from shockcal.study.config_files import SCHEMA_PATH
+    from shockcal.inference.settings import MIN_N_EFF, MIN_N_LIVE
+    from shockcal.study.config_files import load_schema
 
     found = []
 
@@ -479,6 +478,6 @@ def test_every_sampler_setting_in_the_schema_has_the_librarys_minimum():
                     found.append((f"{path}.{key}", value["minimum"], MIN_N_LIVE if key == "n_live" else MIN_N_EFF))
                 walk(value, f"{path}.{key}")
 
-    walk(yaml.safe_load(SCHEMA_PATH.read_text()), "")
+    walk(load_schema(), "")
     assert len(found) >= 8, found
     assert [f for f in found if f[1] != f[2]] == []

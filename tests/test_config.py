@@ -119,10 +119,13 @@ SETTINGS = [
     ("shockcal.velocimetry.settings:ExtractorSettings", ["features", "shots.*.analysis"], {}, True),
     ("shockcal.emulator.settings:EmulatorSettings", ["emulator"], {"seed": "study.seed"}, False),
     ("shockcal.emulator.yield_input:YieldInput", ["emulator.yield_input"], {}, False),
-    ("shockcal.inference.sampler:SamplerSettings", ["calibration"], {}, False),
-    ("shockcal.inference.calibration:CalibrationSettings", [],
+    ("shockcal.inference.settings:SamplerSettings", ["calibration"], {"seed": "study.seed"}, False),
+    ("shockcal.inference.settings:CheckSettings", ["calibration.check"], {}, True),
+    ("shockcal.inference.settings:DiscrepancySettings", ["calibration.discrepancy"], {}, True),
+    ("shockcal.inference.settings:CalibrationSettings", [],
      {"sd_fraction": "observed.sd_fraction", "check_units": "checks.observed_units",
-      "check_plateau": "checks.plateau_vs_velocity"}, False),
+      "check_plateau": "checks.plateau_vs_velocity", "check_training_range": "checks.features_in_training_range",
+      "discrepancy": "calibration.discrepancy"}, False),
     ("shockcal.simulators.command:CommandSettings", ["simulator.command"], {}, False),
     ("shockcal.simulators.outputs:OutputSpec", ["#run_output"], {}, True),
     ("shockcal.campaign.candidates:Candidate", ["next_shot.candidates.*", "#candidate"], {}, False),
@@ -134,10 +137,21 @@ def _schema_node(schema: dict, path: str) -> dict:
     parts = path.split(".")
     node = schema["definitions"][parts.pop(0)[1:]] if parts[0].startswith("#") else schema
     for part in parts:
+        node = _mapping_form(node)
         node = node["additionalProperties"] if part == "*" else node["properties"][part]
         if "$ref" in node:
             node = {**schema["definitions"][node["$ref"].rsplit("/", 1)[1]], **node}
     return node
+
+
+def _section_node(schema: dict, path: str) -> dict:
+    """The schema of the config section at dotted `path` (`_mapping_form`)."""
+    return _mapping_form(_schema_node(schema, path))
+
+
+def _mapping_form(node: dict) -> dict:
+    """A key's schema; of a key that is a mapping or a word (`calibration.discrepancy`), its mapping form's."""
+    return next(option for option in node["oneOf"] if option.get("type") == "object") if "oneOf" in node else node
 
 
 def _field_names(cls) -> list[str]:
@@ -170,7 +184,7 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
     cls = getattr(importlib.import_module(module), name)
     schema = load_schema()
     keys = {field: f"{section}.{field}" for section in reversed(sections) for field in _field_names(cls)
-            if field in _schema_node(schema, section).get("properties", {})} | renamed
+            if field in _section_node(schema, section).get("properties", {})} | renamed
     config = {field: _schema_node(schema, path) for field, path in keys.items()}
     config_defaults = {field: node["default"] for field, node in config.items() if "default" in node}
     library = _library_defaults(cls)
@@ -180,7 +194,7 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
     assert not drift, f"{name}: library default != config default: {drift}"
     if whole:   # the sections' every default is one of the settings', and every field a config key
         section_defaults = {k for section in sections
-                            for k, node in _schema_node(schema, section)["properties"].items() if "default" in node}
+                            for k, node in _section_node(schema, section)["properties"].items() if "default" in node}
         assert section_defaults <= set(library) and set(library) <= set(keys)
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from shockcal.errors import SamplerError
+from shockcal.errors import InputError, SamplerError
 from shockcal.inference.sampler import SamplerSettings, WeightedDraws, nested_sample, pool, sample
 from shockcal.inference.summaries import SUMMARY_QUANTILES, quantile_mcse_between, weighted_quantiles
 
@@ -178,5 +178,5 @@ def test_replicates_pool_independent_runs_the_first_being_the_single_run():
                                        SUMMARY_QUANTILES) for r in range(3)])
     np.testing.assert_allclose(pooled.summary().set_index("parameter").loc["x", ["q05_mcse", "q50_mcse", "q95_mcse"]]
                                .to_numpy(float), own.std(axis=0, ddof=1) / np.sqrt(3))
-    with pytest.raises(ValueError, match="replicates 2"):
+    with pytest.raises(InputError, match="replicates 2"):
         SamplerSettings(replicates=2)

@@ -113,3 +113,91 @@ def test_a_hydro_setting_of_the_wrong_type_is_refused_by_both_doors(paper_config
         validate_config(paper_config, source="config.yaml")
     with pytest.raises(InputError, match=rf"^HydroSettings\.{key} .*: not a number$"):
         HydroSettings(**{key: value})
+
+
+@pytest.mark.parametrize("section, key, value, model", [
+    ("calibration", "n_live", 49, "SamplerSettings"), ("calibration", "n_eff", 99, "SamplerSettings"),
+    ("calibration", "draws", 0, "SamplerSettings"), ("calibration", "replicates", 2, "SamplerSettings"),
+    ("calibration", "replicates", 0, "SamplerSettings"), ("calibration", "max_evaluations", 999, "SamplerSettings"),
+    ("calibration", "n_live", "500", "SamplerSettings"), ("calibration", "n_live", 500.5, "SamplerSettings"),
+    ("calibration", "cube_power", {"m": 0.5}, "SamplerSettings"), ("calibration", "cube_power", {"m": 11},
+                                                                    "SamplerSettings"),
+    ("calibration", "cube_power", {"m": "2"}, "SamplerSettings"), ("calibration", "n_lives", 500, "SamplerSettings"),
+    ("calibration.check", "trials", 0, "CheckSettings"), ("calibration.check", "trials_per_job", 0, "CheckSettings"),
+    ("calibration.check", "n_live", 10, "CheckSettings"), ("calibration.check", "n_eff", 50, "CheckSettings"),
+    ("calibration.discrepancy", "sd_fraction_prior", 0.8, "DiscrepancySettings"),
+    ("calibration.discrepancy", "sd_fraction_prior", 0, "DiscrepancySettings"),
+    ("calibration.discrepancy", "kind", "gp", "DiscrepancySettings"),
+    ("calibration.discrepancy", "rho", 0.5, "DiscrepancySettings"),
+])
+def test_both_doors_refuse_a_bad_calibration_setting_naming_it(paper_config, section, key, value, model):
+    """The sampler's, the check's and the discrepancy's settings: the config names the key (a mapping's key too),
+    the library the model and the field."""
+    import shockcal.inference.settings as settings
+
+    *parents, last = section.split(".")
+    node = paper_config
+    for part in parents:
+        node = node[part]
+    if last == "discrepancy":
+        node[last] = {"kind": "feature_kind"}
+    node[last][key] = value
+    with pytest.raises(ConfigError, match=rf"^config\.yaml: {section.replace('.', r'[.]')}(\.{key})?[.:]"):
+        validate_config(paper_config, source="config.yaml")
+    values = {"kind": "feature_kind", key: value} if last == "discrepancy" else {key: value}
+    with pytest.raises(InputError, match=rf"^{model}\.{key}[. ].*: [^\n]+$"):
+        getattr(settings, model)(**values)
+
+
+def test_replicates_2_is_refused_in_the_models_words_at_both_doors(paper_config):
+    """A rule the schema cannot say (`check_model_sections`): the config's line is the model's reason."""
+    from shockcal.inference.settings import SamplerSettings
+
+    paper_config["calibration"]["replicates"] = 2
+    with pytest.raises(ConfigError) as config_door:
+        validate_config(paper_config, source="config.yaml")
+    with pytest.raises(InputError) as library_door:
+        SamplerSettings(replicates=2)
+    assert str(config_door.value) == f"config.yaml: calibration.replicates: {library_door.value.reason}"
+    assert str(library_door.value).startswith("SamplerSettings.replicates 2: 2 runs give no usable spread")
+
+
+def test_the_calibration_settings_the_config_accepts_reach_the_library_by_name(paper_config):
+    from shockcal.inference.settings import CheckSettings, DiscrepancySettings, SamplerSettings
+    from shockcal.study.adapters import calibration_settings
+
+    paper_config["calibration"].update(n_live=300, n_eff=900, draws=123, replicates=3, cube_power={"m": 2.5},
+                                       max_evaluations=4000, discrepancy={"kind": "feature_kind"},
+                                       check={"n_live": 60, "n_eff": 150})
+    config = validate_config(paper_config)
+    settings = calibration_settings(config, ["104S"])
+    assert all(getattr(settings.sampler, name) == config["calibration"][name] for name in section_fields(SamplerSettings))
+    assert (settings.sampler.n_live, settings.sampler.replicates, settings.sampler.cube_power) == (300, 3, {"m": 2.5})
+    assert settings.discrepancy == DiscrepancySettings(kind="feature_kind", sd_fraction_prior=0.02)
+    assert settings.sd_fraction == config["observed"]["sd_fraction"]
+    trial = calibration_settings(config, ["104S"], check=True).sampler
+    assert (trial.n_live, trial.n_eff, trial.draws, trial.replicates) == (60, 150, 150, 1)
+    assert (trial.cube_power, trial.max_evaluations, trial.seed) == ({"m": 2.5}, 4000, settings.sampler.seed)
+    assert CheckSettings(**config["calibration"]["check"]).trials == 100
+
+
+def test_the_calibration_sections_keys_keep_their_order(paper_config):
+    """The order before the section was generated from SamplerSettings (2026-11-29): no calibrate job reruns."""
+    paper_config["calibration"] = {}
+    calibration = validate_config(paper_config)["calibration"]
+    assert list(calibration) == ["discrepancy", "n_live", "n_eff", "draws", "replicates", "cube_power",
+                                 "max_evaluations", "check"]
+    assert list(calibration["check"]) == ["trials", "trials_per_job", "n_live", "n_eff"]
+
+
+def test_a_calibration_setting_is_frozen_and_its_changed_copy_checked():
+    from shockcal.inference.settings import CalibrationSettings
+
+    settings = CalibrationSettings()
+    with pytest.raises(ValueError):
+        settings.sd_fraction = 0.02
+    assert settings.with_sampler(n_eff=200).sampler.n_eff == 200 and settings.sampler.n_eff == 3000
+    with pytest.raises(InputError, match=r"^SamplerSettings\.n_eff 20: "):
+        settings.with_sampler(n_eff=20)
+    with pytest.raises(InputError, match=r"^DiscrepancySettings\.sd_fraction_prior 0\.8: "):
+        settings.replace(discrepancy={"kind": "feature_kind", "sd_fraction_prior": 0.8})

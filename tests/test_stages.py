@@ -68,3 +68,20 @@ def test_an_undeclared_or_misspelt_key_is_named(config):
         stage_config(config, "simulate")
     with pytest.raises(ValueError, match="unknown stage 'simulation'"):
         stage_config(config, "simulation")
+
+
+@pytest.mark.parametrize("stage, check", [("calibrate", False), ("calibrate_check", True)])
+def test_the_calibrations_read_the_discrepancy_from_their_slice(tmp_path, stage, check):
+    """`shockcal calibrate` and `calibrate-check` read their stage's slice: `calibration.discrepancy` is in it (the
+    posterior then samples the discrepancy's parameters), and a change of it reruns their jobs."""
+    from shockcal.inference.settings import DiscrepancySettings
+    from shockcal.study.adapters import calibration_settings
+    from shockcal.study.stages import load_stage_config
+
+    overlay = tmp_path / "discrepancy.yaml"
+    overlay.write_text(f"extends: {REPO / 'config' / 'config.yaml'}\n"
+                       "calibration: {discrepancy: {kind: feature_kind, sd_fraction_prior: 0.03}}\n")
+    settings = calibration_settings(load_stage_config(overlay, stage), ["104S"], check=check)
+    assert settings.discrepancy == DiscrepancySettings(kind="feature_kind", sd_fraction_prior=0.03)
+    assert calibration_settings(load_stage_config(REPO / "config" / "config.yaml", stage), ["104S"],
+                                check=check).discrepancy == "none"

@@ -24,7 +24,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "PCGPEmulator": "shockcal.emulator.pcgp",
     "EmulatorSettings": "shockcal.emulator.settings",
     "Problem": "shockcal.inference.problem",
-    "SamplerSettings": "shockcal.inference.sampler",
+    "SamplerSettings": "shockcal.inference.settings",
     "sample": "shockcal.inference.sampler",
     "Posterior": "shockcal.inference.sampler",
     "load_study": "shockcal.inference.study_results",

@@ -13,7 +13,7 @@ its physical rules), the emulator's and the extractor's build on it.
 from __future__ import annotations
 
 import difflib
-from typing import Literal, get_args, get_origin
+from typing import Annotated, Literal, get_args, get_origin
 
 import annotated_types
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
@@ -39,8 +39,17 @@ def setting(default, description: str, unit: str | None = None, key: str | None 
     return Field(default, description=description, json_schema_extra=(schema | (extra or {})) or None, **limits)
 
 
+class SettingsError(InputError):
+    """A value a settings model refuses: the message names the class and the field; `field` and `reason` are
+    those parts, for a door that names the value by its config key (`shockcal.study.validate`)."""
+
+    def __init__(self, message: str, field: str, reason: str):
+        super().__init__(message)
+        self.field, self.reason = field, reason
+
+
 class SettingsModel(BaseModel):
-    """Frozen, no unknown fields; a wrong type, choice or limit is one InputError line naming the field."""
+    """Frozen, no unknown fields; a wrong type, choice or limit is one SettingsError line naming the field."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
@@ -49,11 +58,14 @@ class SettingsModel(BaseModel):
             super().__init__(**values)
         except ValidationError as exc:
             error = exc.errors()[0]
-            where = error["loc"][0]      # a field (a union's member after it: n_components.int)
+            where = error["loc"][0]      # a field (a union's member after it: n_components.int; a mapping's key)
+            if get_origin(type(self).model_fields.get(where, Field()).annotation) is dict and len(error["loc"]) > 1:
+                where = f"{where}.{error['loc'][1]}"
             value = "" if error["type"] == "missing" else f" {_shown(error['input'])}"
             close = difflib.get_close_matches(str(where), list(type(self).model_fields), n=1)
             hint = f"; did you mean '{close[0]}'?" if error["type"] == "extra_forbidden" and close else ""
-            raise InputError(f"{type(self).__name__}.{where}{value}: {error['msg']}{hint}") from None
+            reason = f"{error['msg']}{hint}"
+            raise SettingsError(f"{type(self).__name__}.{where}{value}: {reason}", str(where), reason) from None
 
     @field_validator("*", mode="before")
     @classmethod
@@ -101,15 +113,25 @@ def schema_properties(model: type[SettingsModel], required: list[str] = (), sect
     properties = {}
     for name in section_fields(model, section):
         field = model.model_fields[name]
-        if get_origin(field.annotation) is Literal:
-            entry = {"enum": list(get_args(field.annotation))}
-        else:
-            entry = {"type": TYPES[field.annotation]}
-        for limit in field.metadata:
-            entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+        entry = _value_schema(field.annotation, field.metadata)
         entry |= {keyword: value for keyword, value in schema_extras(model)[name].items() if keyword != SECTION}
         if name not in required:
             entry["default"] = field.default
         entry["description"] = field.description
         properties[name] = entry
     return properties
+
+
+def _value_schema(annotation, metadata=()) -> dict:
+    """A value's schema: `enum` for a Literal, `type` and the limits in `metadata` for a number, flag or text, a
+    mapping of names to such values (`dict[str, Annotated[float, Field(ge=1, description=...)]]`) as an
+    object whose `additionalProperties` is the values' schema (with their description)."""
+    if get_origin(annotation) is Annotated:     # a value type with its Field (limits, description)
+        value, info = get_args(annotation)
+        return _value_schema(value, info.metadata) | ({"description": info.description} if info.description else {})
+    if get_origin(annotation) is dict:
+        return {"type": "object", "additionalProperties": _value_schema(get_args(annotation)[1])}
+    entry = {"enum": list(get_args(annotation))} if get_origin(annotation) is Literal else {"type": TYPES[annotation]}
+    for limit in metadata:
+        entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+    return entry

@@ -27,7 +27,7 @@ from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
-from shockcal.hydro.laws import DEFAULT_MODEL, get_law
+from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, get_law
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
 
@@ -53,7 +53,7 @@ class Candidate:
     initial_temperature_K: float | None
     shear_modulus_inputs: tuple[str, ...]
     model: str = DEFAULT_MODEL
-    strength_inputs: tuple[str, ...] = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
+    strength_inputs: tuple[str, ...] = DEFAULT_COLUMNS
 
     def mapping(self) -> ShotMapping:
         """How the candidate reads its design (`candidate_design`'s velocity and shear-modulus columns)."""

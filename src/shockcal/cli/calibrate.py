@@ -91,7 +91,7 @@ def sampler_overrides(settings, n_live: int | None, n_eff: int | None, draws_fol
             continue
         try:
             settings = settings.with_sampler(**changes)
-        except ValueError as exc:
+        except InputError as exc:
             raise InputError(f"{option}: {exc}") from None
     return settings
 

@@ -19,14 +19,12 @@ import pandas as pd
 
 from shockcal.errors import InputError, number, shown
 from shockcal.hydro import LawShotParameters, ShotParameters
-from shockcal.hydro.laws import DEFAULT_MODEL, get_law
+from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, get_law
 from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.design.tables")
-# the columns no design may make negative: the default law's (ShotParameters' rule), whatever the study's law
-NONNEGATIVE_COLUMNS = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
 
 
 @dataclass(frozen=True)
@@ -125,7 +123,7 @@ def load_design(path: str | Path, box: InputBox, columns: list[str] | None = Non
             row = design.loc[bad, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} is not a finite number ({shown(design.loc[bad, name].iloc[0])})")
         design[name] = values.astype(float)
-        if name in NONNEGATIVE_COLUMNS and (values < 0).any():
+        if name in DEFAULT_COLUMNS and (values < 0).any():     # ShotParameters' rule, whatever the study's law
             row = design.loc[values < 0, "run"].iloc[0]
             raise InputError(f"{path}: run {row}: parameter {name} = {number(values[values < 0].iloc[0])} is negative")
     design["run"] = design["run"].astype(np.int64)
@@ -159,13 +157,13 @@ class ShotMapping:
     the inputs whose sum is its shear modulus (Mbar; none for a law with its own G law), and the strength
     law's inputs every shot shares, its design columns (`shockcal.hydro.laws.Law.column`): Johnson-Cook's
     A, B, C, n, m in code units (Mbar), another law's declared parameters in the units their names carry.
-    The default law and its columns are the registry's (`DEFAULT_MODEL`)."""
+    The default law and its columns are the registry's (`DEFAULT_MODEL`, `DEFAULT_COLUMNS`)."""
 
     shot: str
     velocity_input: str
     shear_modulus_inputs: tuple[str, ...]
     model: str = DEFAULT_MODEL
-    strength_inputs: tuple[str, ...] = tuple(get_law(DEFAULT_MODEL).calibrated_columns())
+    strength_inputs: tuple[str, ...] = DEFAULT_COLUMNS
 
     def inputs(self) -> list[str]:
         """The design columns the shot depends on: the law's inputs, its velocity, its shear-modulus terms."""

@@ -1,7 +1,8 @@
 """Inference: posteriors of the strength and shot inputs given the measured features.
 
-`problem` (the posterior density `Problem`: prior transform and batch log-likelihood through the
-emulator), `sampler` (nested sampling with nautilus into a `Posterior`, with log Z and its sd),
+`settings` (the sampler's, the check's, the discrepancy's and a calibration's settings: the config's
+`calibration` section), `problem` (the posterior density `Problem`: prior transform and batch log-likelihood
+through the emulator), `sampler` (nested sampling with nautilus into a `Posterior`, with log Z and its sd),
 `summaries` (weighted quantiles and their Monte Carlo errors), `calibration` (a study's shots
 against its emulator), `coverage` (synthetic-truth checks), `inference_data` (a `Posterior` as
 ArviZ InferenceData), `predict` (emulator predictions at a design),
@@ -14,10 +15,10 @@ from shockcal._lazy import lazy_exports
 
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "Problem": "shockcal.inference.problem",
-    "SamplerSettings": "shockcal.inference.sampler",
+    "SamplerSettings": "shockcal.inference.settings",
     "Posterior": "shockcal.inference.sampler",
     "sample": "shockcal.inference.sampler",
-    "CalibrationSettings": "shockcal.inference.calibration",
+    "CalibrationSettings": "shockcal.inference.settings",
     "calibrate": "shockcal.inference.calibration",
     "read_posterior": "shockcal.inference.posterior_files",
     "load_study": "shockcal.inference.study_results",

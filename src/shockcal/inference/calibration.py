@@ -7,54 +7,13 @@ The density is `shockcal.inference.problem.Problem`, the sampler `shockcal.infer
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
-
 import pandas as pd
 
 from shockcal.inference.problem import LAMBDA_Y, Problem
-from shockcal.inference.sampler import Posterior, SamplerSettings, sample
+from shockcal.inference.sampler import Posterior, sample
+from shockcal.inference.settings import CalibrationSettings
 from shockcal.inference.training_range import check_training_range
 from shockcal.plausibility import check_observed_table, check_plateau
-
-
-@dataclass(frozen=True)
-class CalibrationSettings:
-    """What a calibration needs besides the emulator and the measured features.
-
-    Args:
-        sampler: the nested sampler's settings.
-        sd_fraction: observation sd as a fraction of each measured feature (0.01: 1%).
-        check_units: whether to check that the measurements look like m/s and us (`shockcal.plausibility`).
-        units: each parameter's unit (native: the prior box's and the draws'), for the summary.
-        user_units: each parameter's unit in the summary and the InferenceData, where it differs from
-            `units` (e.g. {"A": "MPa", "G1": "GPa", "V1": "m/s"}; `shockcal.units.user_unit`).
-        bounds: the prior box by input (native units), or None for the emulator's box; it must lie
-            inside the emulator's (`shockcal.inference.problem.prior_box`).
-        velocity_boxes: shot -> its impact-velocity box (m/s), against which each shot's measured
-            plastic plateau is checked (`shockcal.plausibility.check_plateau`); shots absent: unchecked.
-        check_plateau: whether a plateau outside the band stops the calibration (else a warning).
-        check_training_range: whether a measured feature outside the training runs' range (widened by
-            `shockcal.inference.training_range.RANGE_MARGIN`) stops the calibration before it starts (else a
-            warning; config `checks.features_in_training_range`).
-        discrepancy: `calibration.discrepancy` ("none", or {kind: feature_kind, sd_fraction_prior}), the
-            model-discrepancy term (`shockcal.inference.discrepancy`); its parameters are fractions (-).
-    """
-
-    sampler: SamplerSettings = SamplerSettings()
-    sd_fraction: float = 0.01
-    check_units: bool = True
-    units: Mapping[str, str] = field(default_factory=dict)
-    user_units: Mapping[str, str] = field(default_factory=dict)
-    bounds: Mapping[str, tuple[float, float]] | None = None
-    velocity_boxes: Mapping[str, tuple[float, float]] = field(default_factory=dict)
-    check_plateau: bool = True
-    check_training_range: bool = True
-    discrepancy: object = "none"
-
-    def with_sampler(self, **changes) -> CalibrationSettings:
-        """These settings with some sampler settings changed (e.g. `seed`, `n_eff`)."""
-        return replace(self, sampler=replace(self.sampler, **changes))
 
 
 def calibrate(emulator, shots, observed: pd.DataFrame, settings: CalibrationSettings, source: str = "observed"

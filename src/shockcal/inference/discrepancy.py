@@ -21,6 +21,7 @@ import pandas as pd
 from scipy import stats
 
 from shockcal.errors import InputError
+from shockcal.inference.settings import DiscrepancySettings
 
 KINDS = ("none", "feature_kind")
 RHO_NAME = "delta_rho_shots"
@@ -36,7 +37,7 @@ class Discrepancy:
 
     feature_names: tuple[str, ...]
     n_shots: int
-    sd_fraction_prior: float = 0.02
+    sd_fraction_prior: float = DiscrepancySettings.model_fields["sd_fraction_prior"].default
 
     def __post_init__(self):
         if not (np.isfinite(self.sd_fraction_prior) and 0 < self.sd_fraction_prior <= 0.5):
@@ -70,9 +71,12 @@ class Discrepancy:
 
 def from_setting(setting, feature_names, n_shots: int, source: str = "calibration.discrepancy") -> Discrepancy | None:
     """The discrepancy a config's `calibration.discrepancy` asks for: "none" (or absent) -> None; a
-    mapping {kind: feature_kind, sd_fraction_prior: float}. Anything else is one-line InputError."""
+    mapping {kind: feature_kind, sd_fraction_prior: float} or its `DiscrepancySettings`. Anything else is
+    one-line InputError."""
     if setting is None or setting == "none":
         return None
+    if isinstance(setting, DiscrepancySettings):
+        setting = setting.model_dump()
     if isinstance(setting, str):
         setting = {"kind": setting}
     if not isinstance(setting, dict):

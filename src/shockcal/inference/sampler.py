@@ -20,7 +20,6 @@ returns a `Posterior`, which keeps both, the evidence and the sampler's counts.
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,6 +28,7 @@ from scipy.special import logsumexp
 
 from shockcal.errors import SamplerError
 from shockcal.inference.problem import LAMBDA_Y
+from shockcal.inference.settings import SamplerSettings
 from shockcal.inference.summaries import summarize
 from shockcal.progress import Every
 from shockcal.seeds import stream_seed
@@ -171,46 +171,6 @@ def log_volume_variance(bound) -> float:
         if drawn > rejected:
             total += rejected / (drawn * (drawn - rejected))
     return total
-
-
-MIN_N_LIVE = 50          # the config schema's minimum of every n_live (calibration, its check, the next-shot check)
-MIN_N_EFF = 100          # and of every n_eff
-
-
-@dataclass(frozen=True)
-class SamplerSettings:
-    """How nautilus samples a posterior.
-
-    Args:
-        n_live: live points.
-        n_eff: the effective sample size (Kish) of the weighted draws at which the run stops.
-        draws: equal-weight draws resampled from the weighted ones (`Posterior.draws`).
-        seed: the sampler's and the resampling's seed.
-        cube_power: unit-cube power of named inputs (`nested_sample`'s `cube_power`: where the sampler
-            looks, not the posterior).
-        max_evaluations: likelihood evaluations after which a run short of `n_eff` stops with an error.
-        replicates: independent runs (seeds `seed`, then the "replicate" streams of it), each to
-            n_eff / replicates, pooled (`pool`); from 3 on, the quantiles' Monte Carlo errors come from
-            the runs' spread, which also sees the bounds' own randomness (docs/calibration.md,
-            "Monte Carlo errors"). 1: one run, errors from its weights.
-    """
-
-    n_live: int = 500
-    n_eff: int = 3000
-    draws: int = 10000
-    seed: int = 0
-    cube_power: Mapping[str, float] = field(default_factory=dict)
-    max_evaluations: int = 500_000
-    replicates: int = 1
-
-    def __post_init__(self):
-        if self.n_live < MIN_N_LIVE:
-            raise ValueError(f"n_live {self.n_live}: at least {MIN_N_LIVE} live points")
-        if self.n_eff < MIN_N_EFF:
-            raise ValueError(f"n_eff {self.n_eff}: at least {MIN_N_EFF} (an effective sample size below it leaves "
-                             f"the 5% and 95% points to a handful of draws)")
-        if self.replicates < 1 or self.replicates == 2:
-            raise ValueError(f"replicates {self.replicates}: 1, or at least 3 (a spread needs three runs)")
 
 
 @dataclass

@@ -4,7 +4,7 @@ Each adapter takes a validated config (or the slice its stage reads, `shockcal.s
 returns what a library function takes; the library never sees a dict. Field names of the settings
 are the config's keys, so most adapters copy by name. The emulator's and the calibration's modules are
 imported by their adapters, so that a simulate job does not pay for them (0.7 s a job); the settings
-models of the emulator and the extractor are light modules of their own.
+models of the emulator, the extractor and the calibration are light modules of their own.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from shockcal.design.tables import InputBox, ShotMapping, extend_design, latin_h
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.material_library import material_properties as library_material_properties
+from shockcal.inference.settings import CalibrationSettings, SamplerSettings
 from shockcal.seeds import stream_seed
 from shockcal.settings_model import section_fields
 from shockcal.study.config import (
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
 
     from shockcal.campaign.candidates import Candidate
     from shockcal.emulator.study_emulator import EmulatorSpec
-    from shockcal.inference.calibration import CalibrationSettings
 
 
 def input_box(config: dict) -> InputBox:
@@ -161,32 +161,36 @@ def emulator_spec(config: dict, shots) -> EmulatorSpec:
                         yield_input=yield_input)
 
 
+def sampler_settings(config: dict, seed: int, check: bool = False) -> SamplerSettings:
+    """`calibration`'s sampler keys by name, seeded by `seed`; with `check`, a synthetic-truth trial's: n_live and
+    n_eff of `calibration.check`, as many draws as n_eff, one run (`calibration.cube_power` and `max_evaluations`
+    for both)."""
+    section = config["calibration"]
+    if not check:
+        return SamplerSettings(seed=seed, **{name: section[name] for name in section_fields(SamplerSettings)})
+    trial = section["check"]
+    return SamplerSettings(n_live=trial["n_live"], n_eff=trial["n_eff"], draws=trial["n_eff"], seed=seed,
+                           cube_power=section["cube_power"], max_evaluations=section["max_evaluations"])
+
+
 def calibration_settings(config: dict, shots, check: bool = False) -> CalibrationSettings:
-    """`calibration` (with `check`, the synthetic-truth trials' `calibration.check`, whose draws are its
-    n_eff; `calibration.cube_power` for both), `observed.sd_fraction`, `checks.observed_units`, the
+    """`calibration` (`sampler_settings`: with `check`, the synthetic-truth trials' `calibration.check`),
+    `observed.sd_fraction`, `checks.observed_units`, the
     prior box `inputs` and their units, the shots' impact-velocity boxes for the plateau check
     (`checks.plateau_vs_velocity`; not for the check's synthetic measurements), the training-range check
     (`checks.features_in_training_range`; the check's synthetic measurements only warn), seeded by the shots'
     "calibration" stream of study.seed (a trial reseeds from its own); the summary's user units
     (`input_user_units`)."""
-    from shockcal.inference.calibration import CalibrationSettings
-    from shockcal.inference.sampler import SamplerSettings
-
-    section = config["calibration"]["check"] if check else config["calibration"]
-    draws = section["n_eff"] if check else section["draws"]
-    seed = stream_seed(config["study"]["seed"], "calibration", *shots)
-    sampler = SamplerSettings(n_live=section["n_live"], n_eff=section["n_eff"], draws=draws, seed=seed,
-                              cube_power=config["calibration"]["cube_power"],
-                              max_evaluations=config["calibration"]["max_evaluations"],
-                              replicates=1 if check else config["calibration"]["replicates"])
+    sampler = sampler_settings(config, stream_seed(config["study"]["seed"], "calibration", *shots), check)
     boxes = {} if check else {shot: velocity_box_m_s(config, shot) for shot in shots if shot in config["shots"]}
-    return CalibrationSettings(sampler, config["observed"]["sd_fraction"], config["checks"]["observed_units"],
+    return CalibrationSettings(sampler=sampler, sd_fraction=config["observed"]["sd_fraction"],
+                               check_units=config["checks"]["observed_units"],
                                units={name: box["unit"] for name, box in config["inputs"].items()},
                                user_units=input_user_units(config), bounds=prior_bounds(config),
                                velocity_boxes={shot: box for shot, box in boxes.items() if box is not None},
                                check_plateau=config["checks"]["plateau_vs_velocity"],
                                check_training_range=config["checks"]["features_in_training_range"] and not check,
-                               discrepancy=config["calibration"].get("discrepancy", "none"))
+                               discrepancy=config["calibration"]["discrepancy"])
 
 
 def load_study_design(path, config: dict, columns: list[str] | None = None, allow_empty: bool = False

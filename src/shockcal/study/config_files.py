@@ -24,6 +24,7 @@ import yaml
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.settings import HydroSettings
+from shockcal.inference.settings import CheckSettings, DiscrepancySettings, SamplerSettings
 from shockcal.settings_model import other_sections, schema_properties
 from shockcal.velocimetry.settings import ExtractorSettings
 
@@ -35,8 +36,11 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 
 # Config sections whose keys are a library settings model's fields: the schema's entries for them are
 # generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest. A
-# field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there.
-MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "features": ExtractorSettings}
+# field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there. A
+# section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
+MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "features": ExtractorSettings,
+                  "calibration": SamplerSettings, "calibration.check": CheckSettings,
+                  "calibration.discrepancy": DiscrepancySettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
@@ -52,11 +56,13 @@ def _schema_text_parsed() -> dict:
 
 
 def section_schema(schema: dict, section: str) -> dict:
-    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`)."""
+    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`); of
+    a key that is a mapping or something else (`oneOf`), its mapping form's."""
     entry = schema
     for part in section.split("."):
         entry = entry["additionalProperties"] if part == "*" else entry["properties"][part]
-    return entry
+    return next((option for option in entry["oneOf"] if option.get("type") == "object"), entry) if "oneOf" in entry \
+        else entry
 
 
 def _placed(generated: dict, written: dict) -> dict:

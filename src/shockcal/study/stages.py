@@ -19,6 +19,8 @@ from __future__ import annotations
 import copy
 from collections.abc import Iterable, Iterator
 
+from shockcal.inference.settings import SamplerSettings
+from shockcal.settings_model import section_fields
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
 from shockcal.study.strength_config import strength_law, strength_model
@@ -37,6 +39,10 @@ _MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material
 _CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
               "shots.*.analysis", "inputs", "strength.model?", *_MATERIAL)
 _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
+
+# the sampler's keys, SamplerSettings' fields (`sampler_settings` reads them by name): a new field is read, and
+# reruns the calibrations, with no line here
+_SAMPLER = tuple(f"calibration.{name}" for name in section_fields(SamplerSettings))
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
@@ -62,13 +68,12 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the emulator's predictions at a design's runs
     "emulate_predict": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # one calibration (single shot or joint)
-    "calibrate": ("study.seed", "calibration.n_live", "calibration.n_eff", "calibration.draws",
-                  "calibration.replicates", "calibration.cube_power", "calibration.max_evaluations", "observed.sd_fraction",
-                  "checks.observed_units", "checks.plateau_vs_velocity", "checks.features_in_training_range", "inputs",
-                  *_SHOT_MAPPING),
+    "calibrate": ("study.seed", *_SAMPLER, "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
+                  "checks.plateau_vs_velocity", "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a batch of synthetic-truth trials
     "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
-                        "observed.sd_fraction", "checks.observed_units", "checks.plateau_vs_velocity",
+                        "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
+                        "checks.plateau_vs_velocity",
                         "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
     "wave_design": ("study.seed", "design.strategy", "design.waves", "observed.sd_fraction", "inputs",

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from shockcal.errors import ConfigError, InputError
-from shockcal.hydro.laws import DEFAULT_MODEL, Law, flow_stress_at_states, get_law, law_values
+from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, Law, flow_stress_at_states, get_law, law_values
 from shockcal.hydro.laws.boxes import load_boxes
 
 # states at which a box's corners must give a finite, non-negative flow stress:
@@ -41,12 +41,6 @@ def strength_model(config: dict) -> str:
 def strength_law(config: dict) -> Law:
     """The study's law's declaration (`shockcal.hydro.laws.get_law`)."""
     return get_law(strength_model(config))
-
-
-def default_law_columns() -> list[str]:
-    """The inputs a config without `strength` calibrates (the default law's `calibrated_columns`), which a
-    config of another law may still carry from the base config an overlay cannot delete keys of."""
-    return get_law(DEFAULT_MODEL).calibrated_columns()
 
 
 def strength_parameters(config: dict) -> list[str]:
@@ -101,7 +95,7 @@ def apply_strength_model(config: dict, source: str) -> None:
     section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
     cube = config["calibration"]["cube_power"]
     config["calibration"]["cube_power"] = {k: v for k, v in cube.items()
-                                           if k in config["inputs"] or k not in default_law_columns()}
+                                           if k in config["inputs"] or k not in DEFAULT_COLUMNS}
 
 
 def _calibrated(param) -> bool:
@@ -141,7 +135,7 @@ def _shot_inputs(config: dict, law, given: dict, source: str) -> dict:
     for name, spec in config["inputs"].items():
         if name in kept:
             out[name] = spec
-        elif name in default_law_columns() or name in modulus:
+        elif name in DEFAULT_COLUMNS or name in modulus:
             continue
         elif name in given and (given[name]["min"], given[name]["max"]) == (spec["min"], spec["max"]):
             continue

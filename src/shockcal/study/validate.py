@@ -18,7 +18,7 @@ import yaml
 from shockcal.errors import ConfigError, InputError, ShockcalError
 from shockcal.hydro import rules
 from shockcal.hydro.material_library import resolve_material
-from shockcal.study.config_checks import check_design_file, check_semantics, expand_candidate_grid
+from shockcal.study.config_checks import check_design_file, check_model_sections, check_semantics, expand_candidate_grid
 from shockcal.study.config_files import (
     check_filled,
     load_schema,
@@ -53,6 +53,7 @@ def validate_config(config: dict, source: str = "config") -> dict:
         _schema_validator().validate(config)
     except ValidationError as exc:
         raise ConfigError(f"{source}: {_schema_message(exc)}") from None
+    check_model_sections(config, source)
     apply_strength_model(config, source)
     expand_candidate_grid(config, source)
     check_semantics(config, source)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from shockcal.errors import InputError
-from shockcal.hydro.laws.declarations import ALIASES, DEFAULT_MODEL, LAWS, Law, Param
+from shockcal.hydro.laws.declarations import ALIASES, DEFAULT_COLUMNS, DEFAULT_MODEL, LAWS, Law, Param
 from shockcal.units import MBAR_TO_GPA, PER_S_TO_PER_US
 
 if TYPE_CHECKING:
@@ -33,7 +33,7 @@ if TYPE_CHECKING:
 
 MBAR_TO_MPA = 1.0e3 * MBAR_TO_GPA
 
-__all__ = ["DEFAULT_MODEL", "LAWS", "Law", "Param", "check_given", "code_parameters", "flow_stress_at_states",
+__all__ = ["DEFAULT_COLUMNS", "DEFAULT_MODEL", "LAWS", "Law", "Param", "check_given", "code_parameters", "flow_stress_at_states",
            "flow_stress_curve", "get_law", "law_values", "melt_temperature_K", "shear_modulus_gpa", "yield_stress_MPa"]
 
 

@@ -261,4 +261,7 @@ ZERILLI_ARMSTRONG = Law(
 LAWS: dict[str, Law] = {law.name: law for law in (JOHNSON_COOK, STEINBERG_GUINAN, PRESTON_TONKS_WALLACE,
                                                   ZERILLI_ARMSTRONG)}
 DEFAULT_MODEL = JOHNSON_COOK.name    # the law of a study config without `strength.model`, and of `ShotParameters`
+# its design columns (`Law.calibrated_columns`): the inputs of a config without `strength`, the default of a shot's
+# and a candidate's strength inputs, and the columns no design may make negative (ShotParameters' rule)
+DEFAULT_COLUMNS = tuple(JOHNSON_COOK.calibrated_columns())
 ALIASES = {"jc": "johnson-cook", "sg": "steinberg-guinan", "preston-tonks-wallace": "ptw", "za": "zerilli-armstrong"}
