@@ -26,8 +26,8 @@ from shockcal.inference.inference_data import observed_frames
 from shockcal.inference.leave_one_out import leave_one_shot_out
 from shockcal.inference.posterior_files import read_posterior
 from shockcal.inference.predictive_coverage import study_predictive_coverage
-from shockcal.io import read_table_metadata
-from shockcal.study.config import prior_bounds
+from shockcal.io import read_table, read_table_metadata
+from shockcal.study.config import input_columns, prior_bounds
 from shockcal.study.stages import load_stage_config
 
 
@@ -37,15 +37,37 @@ def pair(text: str) -> tuple[str, str, str]:
     return name, path, emulator
 
 
-def side_by_side(specs, draws: int, seed: int) -> None:
-    medians, evidence, coverage = {}, [], {}
-    for name, path, emulator_dir in specs:
+def load(path: str, config: dict | None):
+    """(equal-weight draws, summary in user units with q05/q50/q95/sd, log Z, its sd, metadata) of a `shockcal
+    calibrate` posterior or of `discrepancy_reweight.py`'s reweighted draws (user units from `config`)."""
+    meta = read_table_metadata(path)
+    if meta.get("table") != "importance-reweighted posterior draws":
         posterior = read_posterior(path)
         info = posterior.info()
-        summary = posterior.summary()
+        return posterior.draws, posterior.summary(), posterior.log_evidence, info["log_evidence_sd"], info
+    if config is None:
+        raise SystemExit(f"{path}: reweighted draws need --config for their user units")
+    draws = read_table(path)
+    user = input_columns(config)
+    rows = []
+    for name in draws.columns.drop("log_likelihood"):
+        label, _, factor = user.get(name, (name, "-", 1.0))
+        x = draws[name].to_numpy(float) * factor
+        rows.append({"parameter": label, "q05": np.quantile(x, 0.05), "q50": np.median(x),
+                     "q95": np.quantile(x, 0.95), "sd": x.std()})
+    summary = pd.DataFrame(rows)
+    summary.loc[summary.parameter.str.startswith("delta_"), "parameter"] = [
+        n for n in draws.columns if n.startswith("delta_")]
+    return draws, summary, float(meta["log_evidence"]), float("nan"), meta
+
+
+def side_by_side(specs, draws: int, seed: int, config: dict | None) -> None:
+    medians, evidence, coverage = {}, [], {}
+    for name, path, emulator_dir in specs:
+        posterior_draws, summary, log_z, log_z_sd, info = load(path, config)
         medians[name] = summary.set_index("parameter")[["q50", "sd"]]
-        evidence.append({"posterior": name, "log_Z": posterior.log_evidence, "log_Z_sd": info["log_evidence_sd"],
-                         "likelihood_evaluations": info["likelihood_evaluations"]})
+        evidence.append({"posterior": name, "log_Z": log_z, "log_Z_sd": log_z_sd,
+                         "khat": info.get("khat", float("nan"))})
         emulator = Emulator.load(emulator_dir)
         features = list(emulator.feature_names)
         observed, _ = observed_frames(info["shots"], info["observed"], info["observed_sd_m_s"], features)
@@ -56,7 +78,7 @@ def side_by_side(specs, draws: int, seed: int) -> None:
                   .to_string(index=False, float_format=lambda v: f"{v:.2f}"))
             fractions = summary[summary.parameter.str.startswith("delta_")]
             print(fractions[["parameter", "q05", "q50", "q95"]].to_string(index=False, float_format=lambda v: f"{v:.4f}"))
-        design = posterior.draws.sample(min(draws, len(posterior.draws)), random_state=seed)
+        design = posterior_draws.sample(min(draws, len(posterior_draws)), random_state=seed)
         coverage[name] = study_predictive_coverage(emulator, design, info["shots"], info["observed"],
                                                    info["observed_sd_m_s"], path)
     print("\nmedian (sd) in user units:")
@@ -80,8 +102,7 @@ def side_by_side(specs, draws: int, seed: int) -> None:
                                         for c in out.columns if c.startswith("inside_")))
 
 
-def leave_one_out(specs, config_path: str, measured: str, draws: int, seed: int) -> None:
-    config = load_stage_config(config_path, "calibrate")
+def leave_one_out(specs, config: dict, measured: str, draws: int, seed: int) -> None:
     bounds = prior_bounds(config)
     meta = read_table_metadata(measured)
     shots = list(meta["shots"])
@@ -107,12 +128,13 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--posterior", nargs="*", type=pair, default=[], metavar="NAME=POSTERIOR@EMULATOR")
     parser.add_argument("--loso", nargs="*", type=pair, default=[], metavar="NAME=DIR@EMULATOR")
-    parser.add_argument("--config", help="the study's config (its prior box; with --loso)")
+    parser.add_argument("--config", help="the study's config (its prior box with --loso; user units of reweighted draws)")
     parser.add_argument("--measured", help="a joint posterior whose metadata holds every shot's measured features")
     parser.add_argument("--draws", type=int, default=2000, help="posterior draws the predictive bands use")
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
+    study = load_stage_config(args.config, "calibrate") if args.config else None
     if args.posterior:
-        side_by_side(args.posterior, args.draws, args.seed)
+        side_by_side(args.posterior, args.draws, args.seed, study)
     if args.loso:
-        leave_one_out(args.loso, args.config, args.measured, args.draws, args.seed)
+        leave_one_out(args.loso, study, args.measured, args.draws, args.seed)
