@@ -106,8 +106,7 @@ def run(args):
         print(f"truth {trial + 1}: 90% coverage over the inputs, none "
               f"{done[done.run == 'none'].inside.mean():.2f}, feature_kind "
               f"{done[done.run == 'feature_kind'].inside.mean():.2f}; CPU so far {cost}", flush=True)
-        if (trial + 1) % 5 == 0 or trial + 1 == args.truths:     # a run stopped early keeps its last table
-            report(pd.DataFrame(rows), args, cost, names)
+        report(pd.DataFrame(rows), args, cost, names)     # after every truth: a run stopped early keeps its table
 
 
 def report(table, args, cost, names):

@@ -110,11 +110,11 @@ def leave_one_out(specs, config: dict, measured: str, draws: int, seed: int) -> 
     for name, directory, emulator_dir in specs:
         emulator = Emulator.load(emulator_dir)
         for shot in shots:
-            posterior = read_posterior(f"{directory}/no{shot}.parquet")
-            design = posterior.draws.sample(min(draws, len(posterior.draws)), random_state=seed)
+            posterior_draws, _, log_z, _, _ = load(f"{directory}/no{shot}.parquet", config)
+            design = posterior_draws.sample(min(draws, len(posterior_draws)), random_state=seed)
             table = leave_one_shot_out(emulator, shots, shot, design, np.asarray(meta["observed"], float),
                                        np.asarray(meta["observed_sd_m_s"], float), bounds, seed)
-            rows.append(table.assign(posterior=name, log_Z=posterior.log_evidence))
+            rows.append(table.assign(posterior=name, log_Z=log_z))
     table = pd.concat(rows, ignore_index=True)
     print("\nleave-one-shot-out: the other two shots' posterior predicts each shot's features (its own inputs "
           "from the prior):")
