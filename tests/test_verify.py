@@ -46,6 +46,11 @@ def test_an_emulator_posterior_far_narrower_than_the_hydrocodes_fails_in_one_lin
     assert not verdict.passed and verdict.khat > verdict.threshold
     line = verdict.line()
     assert "\n" not in line and "the emulator misleads in the posterior region" in line and "another wave" in line
+    weights = np.exp(verdict.log_weights)                     # the line says why: few effective draws, sharp L_hydro
+    assert 1.0 <= verdict.raw_ess < 0.1 * S and verdict.largest_weight > 1.0 / S
+    assert verdict.log_lik_sd_hydrocode == pytest.approx(np.std(gaussian_log_lik(theta, 1.0, 1.0)), rel=1e-12)
+    assert verdict.log_lik_sd_emulator == pytest.approx(np.std(gaussian_log_lik(theta, 0.0, 0.2)), rel=1e-12)
+    assert f"Kish ESS {verdict.raw_ess:.1f} of {S}" in line and weights.sum() == pytest.approx(1.0)
     table = corrected_quantiles(theta[:, None], ["A"], verdict)
     assert table["corrected_q50"].isna().all() and not table["passed"].any()
 

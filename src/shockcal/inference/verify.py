@@ -24,6 +24,8 @@ from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
 MIN_DRAWS = 25
 FAILED_VERDICT = ("k-hat {khat:.2f} > {threshold:.2f} (S = {n}): the emulator misleads in the posterior region; "
                   "another wave is the cure (its corrected quantiles are not reported)")
+WEIGHTS_NOTE = ("; raw weights: Kish ESS {ess:.1f} of {n}, the largest {largest:.2f}; log-likelihood sd over the "
+                "draws: emulator {sd_emulator:.1f}, hydrocode {sd_hydrocode:.1f}")
 
 
 @dataclass(frozen=True)
@@ -39,12 +41,18 @@ class VerifySettings:
 
 @dataclass(frozen=True)
 class Verdict:
-    """PSIS of the hydrocode-over-emulator importance ratios: k-hat, its threshold for S draws, and the
-    smoothed log weights (normalised: logsumexp = 0), one per draw."""
+    """PSIS of the hydrocode-over-emulator importance ratios: k-hat, its threshold for S draws, the smoothed log
+    weights (normalised: logsumexp = 0), one per draw, and what says why a verdict failed: the raw weights' Kish
+    effective sample size and largest normalised weight, and the sd over the draws of each log-likelihood (a
+    hydrocode sd far above the emulator's: the hydrocode's posterior is much narrower than the emulator's)."""
 
     khat: float
     threshold: float
     log_weights: np.ndarray
+    raw_ess: float = float("nan")
+    largest_weight: float = float("nan")
+    log_lik_sd_emulator: float = float("nan")
+    log_lik_sd_hydrocode: float = float("nan")
 
     @property
     def n_draws(self) -> int:
@@ -59,7 +67,9 @@ class Verdict:
         if self.passed:
             return (f"k-hat {self.khat:.2f} <= {self.threshold:.2f} (S = {self.n_draws}): the hydrocode-corrected "
                     "quantiles are reliable")
-        return FAILED_VERDICT.format(khat=self.khat, threshold=self.threshold, n=self.n_draws)
+        return (FAILED_VERDICT.format(khat=self.khat, threshold=self.threshold, n=self.n_draws)
+                + WEIGHTS_NOTE.format(ess=self.raw_ess, n=self.n_draws, largest=self.largest_weight,
+                                      sd_emulator=self.log_lik_sd_emulator, sd_hydrocode=self.log_lik_sd_hydrocode))
 
 
 def khat_threshold(n_draws: int) -> float:
@@ -92,7 +102,11 @@ def psis_verdict(log_lik_hydrocode, log_lik_emulator) -> Verdict:
         raise InputError(f"verify: draw {int(np.argmax(bad))}: a log-likelihood is not finite")
     log_ratio = hydro - emulator
     smoothed, khat = arviz.psislw(log_ratio - log_ratio.max())
-    return Verdict(float(np.asarray(khat)), khat_threshold(len(hydro)), np.asarray(smoothed, dtype=float))
+    raw = np.exp(log_ratio - log_ratio.max())
+    raw /= raw.sum()
+    return Verdict(float(np.asarray(khat)), khat_threshold(len(hydro)), np.asarray(smoothed, dtype=float),
+                   raw_ess=float(1.0 / np.sum(raw ** 2)), largest_weight=float(raw.max()),
+                   log_lik_sd_emulator=float(emulator.std()), log_lik_sd_hydrocode=float(hydro.std()))
 
 
 def corrected_quantiles(draws: np.ndarray, names: list[str], verdict: Verdict, quantiles=SUMMARY_QUANTILES
