@@ -68,6 +68,9 @@ def test_bad_input_is_refused_in_one_line(paper_config):
     paper_config["verify"] = {"n_draws": 10}
     with pytest.raises(ConfigError, match=r"verify\.n_draws: 10 is less than the minimum of 25"):
         validate_config(paper_config, source="config.yaml")
+    with pytest.raises(InputError, match="calibration.discrepancy: 'feature_kind': the hydrocode's verdict does not"):
+        VerifySettings(300, {"kind": "feature_kind", "sd_fraction_prior": 0.02})
+    assert VerifySettings(300, {"kind": "none"}).n_draws == VerifySettings(300, None).n_draws == 300
     with pytest.raises(InputError, match="verify.n_draws: 10 is not an integer >= 25"):
         VerifySettings(10)
     with pytest.raises(InputError, match="one of each per draw"):

@@ -70,7 +70,7 @@ def run(args) -> int:
 
     log = logging.getLogger("shockcal.verify")
     config = load_stage_config(args.config, "verify")
-    settings = VerifySettings(config["verify"]["n_draws"])
+    settings = VerifySettings(config["verify"]["n_draws"], config["calibration"]["discrepancy"])
     emulator = study_emulator(args.emulator, config)
     shots = list(config["shots"])
     units = {name: box["unit"] for name, box in config["inputs"].items()}

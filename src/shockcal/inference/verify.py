@@ -30,13 +30,21 @@ WEIGHTS_NOTE = ("; raw weights: Kish ESS {ess:.1f} of {n}, the largest {largest:
 
 @dataclass(frozen=True)
 class VerifySettings:
-    """`verify` of the study config: `n_draws` joint-posterior draws (S) run through the hydrocode."""
+    """`verify` of the study config: `n_draws` joint-posterior draws (S) run through the hydrocode, for a study
+    whose `calibration.discrepancy` is `discrepancy` (only "none": the verdict does not weigh a discrepancy term,
+    whose parameters the draws do not carry, so a study with one is refused rather than given a wrong verdict)."""
 
     n_draws: int = 300
+    discrepancy: object = "none"
 
     def __post_init__(self):
         if int(self.n_draws) != self.n_draws or self.n_draws < MIN_DRAWS:
             raise InputError(f"verify.n_draws: {self.n_draws!r} is not an integer >= {MIN_DRAWS}")
+        kind = self.discrepancy if self.discrepancy is None or isinstance(self.discrepancy, str) else (
+            self.discrepancy.get("kind") if isinstance(self.discrepancy, dict) else self.discrepancy.kind)
+        if kind not in (None, "none"):
+            raise InputError(f"calibration.discrepancy: {kind!r}: the hydrocode's verdict does not weigh a discrepancy "
+                             "term yet (its draws carry none); verify the study with `discrepancy: none`")
 
 
 @dataclass(frozen=True)

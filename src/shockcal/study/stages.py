@@ -87,7 +87,8 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
     # the hydrocode's verdict (`make verify`): its posterior draws, and their PSIS against the emulator's likelihood
     "verify_design": ("study.seed", "verify.n_draws", "inputs", "shots.*.velocity_input"),
-    "verify": ("verify.n_draws", "observed.sd_fraction", "inputs", "checks.design_box", *_SHOT_MAPPING),
+    "verify": ("verify.n_draws", "calibration.discrepancy", "observed.sd_fraction", "inputs", "checks.design_box",
+               *_SHOT_MAPPING),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
     "sensitivity": ("study.seed", "sensitivity", "inputs", "shots.*.shear_modulus_inputs"),
     # a next-shot candidate's design: the joint posterior's draws with the new shot's nuisance inputs
