@@ -27,7 +27,7 @@ define study
 endef
 
 .DEFAULT_GOAL := help
-.PHONY: help env study paper quick flag-archive models models-paper models-reduced models-quick check verify next-shot next-shot-check test test-slow test-slurm bench validate lint lock clean
+.PHONY: help env study paper quick flag-archive models models-paper models-reduced models-quick check verify next-shot next-shot-check test test-workflow test-slow test-slurm bench validate lint lock clean
 
 help:  ## these targets, one line each
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /\1\t/' | expand -t 18
@@ -121,8 +121,13 @@ next-shot-check: $(INSTALLED)  ## the realized check of the next-shot ranking: i
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot_check $(STUDY_CONFIG)
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/next_shot/check_summary.csv (per trial: check.csv)"
 
-test: $(INSTALLED)  ## fast tests (slow ones are behind the `slow` marker)
-	$(VENV)/bin/pytest
+# TEST_WORKERS: pytest-xdist workers for make test (auto: one per core), each taking a whole test file at a time
+TEST_WORKERS ?= auto
+test: $(INSTALLED)  ## fast tests on TEST_WORKERS workers: all but the `slow` and `workflow` markers (CI: make lint test test-workflow)
+	$(VENV)/bin/pytest -m "not slow and not workflow" -n $(TEST_WORKERS) --dist loadfile
+
+test-workflow: $(INSTALLED)  ## the tests that read the quick study, which they run end to end by snakemake first (the `workflow` marker)
+	$(VENV)/bin/pytest -m "workflow and not slow"
 
 test-slow: $(INSTALLED)  ## the slow checks only
 	$(VENV)/bin/pytest -m slow

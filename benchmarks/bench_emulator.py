@@ -20,7 +20,7 @@ from shockcal.emulator.study_emulator import fit_emulator, rmse_table
 from shockcal.reference import reference_dir
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 SHOTS = ["104S", "105S", "106S"]

@@ -33,7 +33,8 @@ from shockcal.inference.problem import observed_vector, readout_vector
 from shockcal.study.adapters import extractor_settings, hydro_inputs, observed_table, shot_mapping
 from shockcal.study.config import prior_bounds, shot_config
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES, extract_features
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
+from shockcal.velocimetry.features import extract_features
 
 TRUTH = dict(A=9.0e-4, B=2.92e-3, C=0.025, n=0.31, m=1.09, V1=0.030, V2=0.050, G=0.46)  # make_records.py's, config units
 CHI2_90 = 2.706   # chi-square with 1 dof, 90%

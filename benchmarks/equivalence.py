@@ -55,7 +55,7 @@ def features(out: str, runs: int, perturb: float, config_path: Path, cfl: float 
 
 
 def compare(reference: str, candidate: str, floor: str) -> None:
-    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
     keys = ["shot", "run"]
     ref, cand, flo = (pd.read_parquet(p).set_index(keys).sort_index() for p in (reference, candidate, floor))

@@ -49,7 +49,7 @@ from shockcal.study.adapters import (
 )
 from shockcal.study.config import prior_bounds, shot_config
 from shockcal.study.validate import load_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 REPO = Path(__file__).resolve().parents[1]
 REFERENCE = REPO / "tests" / "data" / "reference_posterior_joint.parquet"

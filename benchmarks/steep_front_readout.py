@@ -22,9 +22,9 @@ import yaml
 
 from shockcal.hydro import Geometry, ShotParameters, run_shot
 from shockcal.hydro.settings import MaterialProperties
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 from shockcal.velocimetry.feature_tables import readout_sd
 from shockcal.velocimetry.features import (
-    CALIBRATION_FEATURES,
     ExtractorSettings,
     FeatureError,
     extract,

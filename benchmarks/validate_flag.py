@@ -29,8 +29,8 @@ from shockcal.reference import require_reference_dir
 from shockcal.simulators.builtin import simulate_design
 from shockcal.study.adapters import emulator_spec, extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.validate import load_config
+from shockcal.velocimetry.columns import COLUMNS
 from shockcal.velocimetry.feature_tables import features_table, record_features
-from shockcal.velocimetry.features import COLUMNS
 
 CONFIG = Path(__file__).resolve().parents[1] / "config" / "config.yaml"
 SHOTS = ["104S", "105S", "106S"]
@@ -96,7 +96,7 @@ def input_dependent_share(shot: str, ours: pd.DataFrame, flag: pd.DataFrame, des
     (with the emulator's input powers), and the scatter sd (m/s) it leaves."""
     from shockcal.emulator.input_map import shot_input_map
     from shockcal.emulator.pcgp import EmulatorSettings, PCGPEmulator
-    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
     ok = ours[ours["status"] == "ok"].set_index("run")
     spec = emulator_spec(config, [shot])

@@ -71,6 +71,15 @@ class BackgroundStudy:
 QUICK_STUDY = pytest.StashKey[BackgroundStudy]()
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items):
+    """Mark `workflow` every test that needs the quick study (directly or through another fixture), before
+    `-m` selects: `make test` runs the others on pytest-xdist workers, `make test-workflow` these."""
+    for item in items:
+        if "quick_study" in item.fixturenames:
+            item.add_marker(pytest.mark.workflow)
+
+
 def pytest_collection_finish(session):
     """Start the quick study as soon as the tests are known, when one of them needs it."""
     if any("quick_study" in item.fixturenames for item in session.items):

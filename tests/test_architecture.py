@@ -74,3 +74,18 @@ def test_no_import_circles_between_packages():
     for module, imported in _imports().items():
         graph.setdefault(_room(module), set()).update({_room(i) for i in imported} - {_room(module)})
     graphlib.TopologicalSorter(graph).prepare()      # raises CycleError naming the circle
+
+
+def test_a_simulate_job_loads_neither_the_feature_extractor_nor_scipy_stats():
+    """The most numerous job of a study pays only for what it runs: what `shockcal simulate` imports (its
+    command's imports and the built-in simulator) leaves out scipy.stats (1.7 CPU-s of a job's start,
+    measured 2026-11-29) and scikit-learn, which a change of import placement could bring back."""
+    import subprocess
+    import sys
+
+    tree = ast.parse((PACKAGE / "cli" / "simulate.py").read_text())
+    modules = sorted({node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
+                      and node.module.startswith("shockcal")} | {"shockcal.simulators.builtin"})
+    code = "; ".join(f"import {m}" for m in modules) + "; import sys; print(' '.join(sorted(sys.modules)))"
+    loaded = set(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split())
+    assert not loaded & {"scipy.stats", "sklearn", "shockcal.velocimetry.features", "matplotlib"}

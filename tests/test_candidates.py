@@ -36,7 +36,7 @@ from shockcal.study.adapters import candidate
 from shockcal.study.config import candidate_config, input_names, prior_bounds
 from shockcal.study.strength_config import next_shot_targets
 from shockcal.study.validate import validate_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 AL5083 = load_material("al5083")   # the paper's Al-5083, from the material library
 

@@ -126,6 +126,7 @@ SETTINGS = [
      {"sd_fraction": "observed.sd_fraction", "check_units": "checks.observed_units",
       "check_plateau": "checks.plateau_vs_velocity", "check_training_range": "checks.features_in_training_range",
       "discrepancy": "calibration.discrepancy"}, False),
+    ("shockcal.inference.settings:VerifySettings", ["verify"], {"discrepancy": "calibration.discrepancy"}, True),
     ("shockcal.simulators.command:CommandSettings", ["simulator.command"], {}, False),
     ("shockcal.simulators.outputs:OutputSpec", ["#run_output"], {}, True),
     ("shockcal.campaign.candidates:Candidate", ["next_shot.candidates.*", "#candidate"], {}, False),

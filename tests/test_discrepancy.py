@@ -71,12 +71,13 @@ def test_student_t_blocks_are_refused_with_a_discrepancy():
 
 
 @pytest.mark.parametrize("setting, message", [
-    ("gp", "is not one of"),
-    ({"kind": "feature_kind", "sd_fraction_prior": -0.1}, "not a positive fraction"),
-    ({"kind": "feature_kind", "sd_fraction_prior": "a lot"}, "is not a number"),
-    ({"kind": "feature_kind", "rho": 0.5}, "unknown key"),
+    ("gp", "give 'none'"),
+    ({"kind": "gp"}, r"kind 'gp': Input should be 'none' or 'feature_kind'"),
+    ({"kind": "feature_kind", "sd_fraction_prior": -0.1}, r"sd_fraction_prior -0.1: Input should be greater than 0"),
+    ({"kind": "feature_kind", "sd_fraction_prior": "a lot"}, "sd_fraction_prior 'a lot': not a number"),
+    ({"kind": "feature_kind", "rho": 0.5}, "rho 0.5: Extra inputs are not permitted"),
     (3, "give 'none'"),
-    ({"kind": "feature_kind", "sd_fraction_prior": 0.8}, "up to 0.5"),
+    ({"kind": "feature_kind", "sd_fraction_prior": 0.8}, "less than or equal to 0.5"),
 ])
 def test_wrong_settings_are_refused_in_one_line(setting, message):
     with pytest.raises(InputError, match=message) as info:

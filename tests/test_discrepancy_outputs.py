@@ -20,7 +20,7 @@ from shockcal.inference.posterior_files import companion_path, read_posterior, w
 from shockcal.inference.sampler import Posterior, WeightedDraws
 from shockcal.io import read_table_metadata
 from shockcal.study.adapters import calibration_settings
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 az = pytest.importorskip("arviz")
 REPO = Path(__file__).resolve().parents[1]

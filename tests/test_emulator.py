@@ -13,7 +13,7 @@ from shockcal.emulator.study_emulator import Emulator, fit_emulator, rmse_table
 from shockcal.errors import InputError
 from shockcal.study.adapters import emulator_spec
 from shockcal.study.config import prior_bounds
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 NOISE = 0.05
 

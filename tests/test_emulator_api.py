@@ -160,7 +160,7 @@ def test_predict_emulator_writes_every_run_shot_and_feature(tmp_path, paper_conf
     from shockcal.design.tables import latin_hypercube
     from shockcal.emulator.study_emulator import Emulator, fit_emulator
     from shockcal.study.config import prior_bounds
-    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
     design = latin_hypercube(prior_bounds(paper_config), 30, 1)
     features = pd.DataFrame({f: 100 + 50 * design["A"] / 0.01 + 10 * i + 1e3 * design["V1"]

@@ -11,9 +11,9 @@ from scipy.stats import norm
 
 from shockcal.errors import InputError
 from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.columns import COLUMNS
 from shockcal.velocimetry.feature_tables import features_table, record_features
 from shockcal.velocimetry.features import (
-    COLUMNS,
     Mixture,
     extract,
     extract_features,

@@ -17,7 +17,7 @@ from shockcal.errors import InputError
 from shockcal.inference.inference_data import config_digest, git_commit, observed_frames, posterior_inference_data
 from shockcal.io import write_table
 from shockcal.study.stages import load_stage_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 az = pytest.importorskip("arviz")
 REPO = Path(__file__).resolve().parents[1]

@@ -22,7 +22,8 @@ from shockcal.hydro.plastic_return import NO_MEMORY, cell_shear_modulus, initial
 from shockcal.hydro.state import LawStrength
 from shockcal.study.adapters import extractor_settings, hydro_inputs
 from shockcal.study.config import shot_config
-from shockcal.velocimetry.features import CALIBRATION_FEATURES, extract_features
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
+from shockcal.velocimetry.features import extract_features
 
 AL5083 = load_material("al5083")
 T_REF, T_MELT = AL5083.T_ref_K, AL5083.T_melt_K

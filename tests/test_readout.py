@@ -12,8 +12,9 @@ from scipy.stats import norm
 
 from shockcal.seeds import stream_seed
 from shockcal.study.adapters import extractor_settings
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 from shockcal.velocimetry.feature_tables import readout_sd
-from shockcal.velocimetry.features import CALIBRATION_FEATURES, extract, monotone_cdf, read_velocity, readout_replicates
+from shockcal.velocimetry.features import extract, monotone_cdf, read_velocity, readout_replicates
 from shockcal.velocimetry.record_noise import NoiseModel, estimate_noise
 from shockcal.velocimetry.records import read_record
 

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from shockcal.cli import main
-from shockcal.velocimetry.features import COLUMNS
+from shockcal.velocimetry.columns import COLUMNS
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -165,8 +165,9 @@ def test_a_killed_job_resumes_without_rerunning_finished_runs(paper_config, tmp_
 ])
 def test_a_code_that_writes_its_own_features(paper_config, tmp_path, value, status, reason):
     """`output.kind: features`: the row's features reach the features table as they are."""
+    from shockcal.velocimetry.columns import COLUMNS
     from shockcal.velocimetry.feature_tables import features_table
-    from shockcal.velocimetry.features import COLUMNS, ExtractorSettings
+    from shockcal.velocimetry.features import ExtractorSettings
 
     features = dict(paper_config["observed"]["features"][SHOT])
     if value is not None:

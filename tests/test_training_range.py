@@ -13,7 +13,7 @@ from shockcal.errors import InputError
 from shockcal.inference.calibration import calibrate
 from shockcal.inference.training_range import RANGE_MARGIN, TrainingRange, check_training_range, training_ranges
 from shockcal.study.adapters import calibration_settings
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 TRAINING = pd.DataFrame({"v_elastic": np.linspace(20.0, 40.0, 40), "v_plastic": np.linspace(480.0, 520.0, 40),
                          "v_slope1": np.linspace(52.0, 102.0, 40), "v_slope2": np.linspace(428.0, 475.0, 40)})

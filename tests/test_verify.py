@@ -9,7 +9,8 @@ from scipy import stats
 
 from shockcal.errors import ConfigError, InputError
 from shockcal.inference.problem import Problem
-from shockcal.inference.verify import VerifySettings, corrected_quantiles, khat_threshold, psis_verdict
+from shockcal.inference.settings import VerifySettings
+from shockcal.inference.verify import corrected_quantiles, khat_threshold, psis_verdict
 from shockcal.study.validate import validate_config
 
 S = 4000
@@ -68,11 +69,11 @@ def test_bad_input_is_refused_in_one_line(paper_config):
     paper_config["verify"] = {"n_draws": 10}
     with pytest.raises(ConfigError, match=r"verify\.n_draws: 10 is less than the minimum of 25"):
         validate_config(paper_config, source="config.yaml")
-    with pytest.raises(InputError, match="calibration.discrepancy: 'feature_kind': the hydrocode's verdict does not"):
-        VerifySettings(300, {"kind": "feature_kind", "sd_fraction_prior": 0.02})
-    assert VerifySettings(300, {"kind": "none"}).n_draws == VerifySettings(300, None).n_draws == 300
-    with pytest.raises(InputError, match="verify.n_draws: 10 is not an integer >= 25"):
-        VerifySettings(10)
+    with pytest.raises(InputError, match="calibration.discrepancy is 'feature_kind': the hydrocode's verdict does not"):
+        VerifySettings(n_draws=300, discrepancy={"kind": "feature_kind", "sd_fraction_prior": 0.02})
+    assert VerifySettings(discrepancy={"kind": "none"}).n_draws == VerifySettings(discrepancy=None).n_draws == 300
+    with pytest.raises(InputError, match=r"VerifySettings\.n_draws 10: Input should be greater than or equal to 25"):
+        VerifySettings(n_draws=10)
     with pytest.raises(InputError, match="one of each per draw"):
         psis_verdict(np.zeros(30), np.zeros(31))
     with pytest.raises(InputError, match="at least 25"):

@@ -135,7 +135,7 @@ def run_suggest(args) -> int:
     from shockcal.study.config import input_names
     from shockcal.study.stages import load_stage_config
     from shockcal.study.strength_config import next_shot_targets
-    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
     config = load_stage_config(args.config, "suggest_shot")
     section = config["next_shot"]

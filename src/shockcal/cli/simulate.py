@@ -46,7 +46,7 @@ def run(args) -> int:
     from shockcal.study.config import candidate_config, shot_config
     from shockcal.study.simulator import simulator_kind
     from shockcal.study.stages import is_candidate, load_stage_config
-    from shockcal.velocimetry.features import COLUMNS as FEATURE_COLUMNS
+    from shockcal.velocimetry.columns import COLUMNS as FEATURE_COLUMNS
 
     name = args.shot
     is_shot = not is_candidate(args.config, name)

@@ -62,7 +62,8 @@ def run(args) -> int:
     from shockcal.cli.calibrate import study_emulator
     from shockcal.errors import InputError
     from shockcal.inference.problem import LAMBDA_Y, Problem
-    from shockcal.inference.verify import VerifySettings, corrected_quantiles, psis_verdict
+    from shockcal.inference.settings import VerifySettings
+    from shockcal.inference.verify import corrected_quantiles, psis_verdict
     from shockcal.io import read_table, require_columns
     from shockcal.study.adapters import load_study_design
     from shockcal.study.config import input_columns, input_user_units, prior_bounds
@@ -70,7 +71,7 @@ def run(args) -> int:
 
     log = logging.getLogger("shockcal.verify")
     config = load_stage_config(args.config, "verify")
-    settings = VerifySettings(config["verify"]["n_draws"], config["calibration"]["discrepancy"])
+    settings = VerifySettings(**config["verify"], discrepancy=config["calibration"]["discrepancy"])
     emulator = study_emulator(args.emulator, config)
     shots = list(config["shots"])
     units = {name: box["unit"] for name, box in config["inputs"].items()}

@@ -155,7 +155,7 @@ def max_variance_score(args, config):
     from shockcal.design.waves import relative_variance
     from shockcal.errors import InputError
     from shockcal.io import read_table
-    from shockcal.velocimetry.features import CALIBRATION_FEATURES
+    from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
     if not args.emulator or not args.observed:
         raise InputError("wave-design: design.waves.criterion max_variance needs --emulator and --observed")

@@ -34,8 +34,8 @@ from shockcal.errors import InputError, shown
 from shockcal.io import atomic_path
 from shockcal.plausibility import outside_box
 from shockcal.seeds import stream_seed
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 from shockcal.velocimetry.feature_tables import reason_kind
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
 
 log = logging.getLogger("shockcal.emulator.study_emulator")
 

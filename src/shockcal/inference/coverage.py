@@ -15,7 +15,7 @@ from shockcal.errors import InputError, ShockcalError
 from shockcal.inference.calibration import CalibrationSettings, calibrate
 from shockcal.inference.problem import LAMBDA_Y, LAMBDA_Y_PRIOR, Problem, log_density, prior_box
 from shockcal.progress import progress
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 log = logging.getLogger("shockcal.inference.coverage")
 

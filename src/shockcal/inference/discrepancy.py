@@ -23,7 +23,6 @@ from scipy import stats
 from shockcal.errors import InputError
 from shockcal.inference.settings import DiscrepancySettings
 
-KINDS = ("none", "feature_kind")
 RHO_NAME = "delta_rho_shots"
 SD_FRACTION_PREFIX = "delta_sd_fraction_"
 SD_PREFIX = "delta_sd_"            # the implied sd in m/s: delta_sd_<feature>_m_s (`implied_sd_table`)
@@ -40,9 +39,7 @@ class Discrepancy:
     sd_fraction_prior: float = DiscrepancySettings.model_fields["sd_fraction_prior"].default
 
     def __post_init__(self):
-        if not (np.isfinite(self.sd_fraction_prior) and 0 < self.sd_fraction_prior <= 0.5):
-            raise InputError(f"calibration.discrepancy.sd_fraction_prior = {self.sd_fraction_prior!r} is not a "
-                             "positive fraction up to 0.5 (e.g. 0.02)")
+        DiscrepancySettings(kind="feature_kind", sd_fraction_prior=self.sd_fraction_prior)   # its limits, or a SettingsError
 
     @property
     def names(self) -> list[str]:
@@ -69,30 +66,20 @@ class Discrepancy:
         return sd[:, :, None] * corr * sd[:, None, :]
 
 
-def from_setting(setting, feature_names, n_shots: int, source: str = "calibration.discrepancy") -> Discrepancy | None:
-    """The discrepancy a config's `calibration.discrepancy` asks for: "none" (or absent) -> None; a
-    mapping {kind: feature_kind, sd_fraction_prior: float} or its `DiscrepancySettings`. Anything else is
-    one-line InputError."""
+def from_setting(setting, feature_names, n_shots: int) -> Discrepancy | None:
+    """The discrepancy a config's `calibration.discrepancy` asks for: "none" (or absent) -> None; a mapping
+    {kind, sd_fraction_prior} or its `DiscrepancySettings`, checked by that model (a SettingsError naming the
+    field); anything else is a one-line InputError."""
     if setting is None or setting == "none":
         return None
-    if isinstance(setting, DiscrepancySettings):
-        setting = setting.model_dump()
-    if isinstance(setting, str):
-        setting = {"kind": setting}
-    if not isinstance(setting, dict):
-        raise InputError(f"{source} = {setting!r}: give 'none' or {{kind: feature_kind, sd_fraction_prior: 0.02}}")
-    unknown = sorted(set(setting) - {"kind", "sd_fraction_prior"})
-    if unknown:
-        raise InputError(f"{source}: unknown key(s) {unknown}; allowed: kind, sd_fraction_prior")
-    kind = setting.get("kind", "feature_kind")
-    if kind not in KINDS:
-        raise InputError(f"{source}.kind = {kind!r} is not one of {list(KINDS)}")
-    if kind == "none":
+    if isinstance(setting, dict):
+        setting = DiscrepancySettings(**setting)
+    if not isinstance(setting, DiscrepancySettings):
+        raise InputError(f"calibration.discrepancy = {setting!r}: give 'none' or {{kind: feature_kind, "
+                         "sd_fraction_prior: 0.02}")
+    if setting.kind == "none":
         return None
-    prior = setting.get("sd_fraction_prior", Discrepancy.sd_fraction_prior)
-    if isinstance(prior, bool) or not isinstance(prior, (int, float)):
-        raise InputError(f"{source}.sd_fraction_prior = {prior!r} is not a number")
-    return Discrepancy(tuple(feature_names), int(n_shots), float(prior))
+    return Discrepancy(tuple(feature_names), int(n_shots), setting.sd_fraction_prior)
 
 
 def enabled(setting) -> bool:

@@ -53,7 +53,7 @@ from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, SD_PREFIX, descri
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.io import atomic_path
 from shockcal.units import user_columns
-from shockcal.velocimetry.features import CALIBRATION_FEATURES
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 WEIGHTED_GROUP = "weighted_posterior"
 

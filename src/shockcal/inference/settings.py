@@ -1,5 +1,5 @@
 """How a posterior is sampled and checked: the study config's `calibration` section as settings models (the
-sampler's keys, `calibration.check` and the mapping form of `calibration.discrepancy`). Light on purpose: the
+sampler's keys, `calibration.check` and the mapping form of `calibration.discrepancy`), and its `verify`. Light on purpose: the
 config's schema is generated from them when any command reads a config, without loading the sampler's numerics.
 """
 
@@ -14,6 +14,9 @@ from shockcal.settings_model import SettingsModel, setting
 
 MIN_N_LIVE = 50          # the least live points of every sampler (calibration, its check, the next-shot check)
 MIN_N_EFF = 100          # and the least effective sample size: below it the 5% and 95% points rest on a handful of draws
+# PSIS fits the largest ceil(S / 5) weights (for S < 225); ArviZ gives k-hat = inf below 5 of them (S <= 20). At
+# S = 25 the threshold 1 - 1/log10(S) is 0.28.
+MIN_VERIFY_DRAWS = 25
 
 CubePower = Annotated[float, Field(strict=True, ge=1, le=10,
                                    description="The power p of this input's unit-cube coordinate.")]
@@ -121,3 +124,27 @@ class CalibrationSettings(SettingsModel):
     def with_sampler(self, **changes) -> CalibrationSettings:
         """These settings with some sampler settings changed (e.g. `seed`, `n_eff`), checked."""
         return self.replace(sampler=self.sampler.replace(**changes))
+
+
+class VerifySettings(SettingsModel):
+    """The hydrocode's verdict on the joint posterior (`shockcal.inference.verify`, `make verify`): the study
+    config's `verify` section, for a study whose `calibration.discrepancy` is `discrepancy`. A study with a
+    discrepancy term is refused rather than given a wrong verdict: the verdict does not weigh the term, whose
+    parameters the draws do not carry."""
+
+    n_draws: int = setting(
+        300, "Joint-posterior draws S run through the hydrocode for every shot (the run set verify). k-hat passes "
+        "below min(1 - 1/log10(S), 0.7): 0.60 at S = 300, 0.28 at the fewest, 25 (ArviZ's PSIS fits the largest S/5 "
+        "weights and needs 5 of them).", ge=MIN_VERIFY_DRAWS)
+    discrepancy: DiscrepancySettings | Literal["none"] | None = setting(
+        "none", "The study's discrepancy term; only none (or a mapping of kind none) can be verified.",
+        key="calibration.discrepancy")
+
+    @field_validator("discrepancy")
+    @classmethod
+    def _no_discrepancy_term(cls, discrepancy):
+        if discrepancy not in (None, "none") and discrepancy.kind != "none":
+            raise PydanticCustomError("discrepancy", "calibration.discrepancy is '{kind}': the hydrocode's verdict does "
+                                                     "not weigh a discrepancy term yet (its draws carry none); verify "
+                                                     "the study with `discrepancy: none`", {"kind": discrepancy.kind})
+        return discrepancy

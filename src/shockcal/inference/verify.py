@@ -17,34 +17,13 @@ import numpy as np
 import pandas as pd
 
 from shockcal.errors import InputError
+from shockcal.inference.settings import MIN_VERIFY_DRAWS
 from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
 
-# PSIS fits the largest ceil(S / 5) weights (for S < 225); ArviZ gives k-hat = inf below 5 of them (S <= 20). At
-# S = 25 the threshold 1 - 1/log10(S) is 0.28.
-MIN_DRAWS = 25
 FAILED_VERDICT = ("k-hat {khat:.2f} > {threshold:.2f} (S = {n}): the emulator misleads in the posterior region; "
                   "another wave is the cure (its corrected quantiles are not reported)")
 WEIGHTS_NOTE = ("; raw weights: Kish ESS {ess:.1f} of {n}, the largest {largest:.2f}; log-likelihood sd over the "
                 "draws: emulator {sd_emulator:.1f}, hydrocode {sd_hydrocode:.1f}")
-
-
-@dataclass(frozen=True)
-class VerifySettings:
-    """`verify` of the study config: `n_draws` joint-posterior draws (S) run through the hydrocode, for a study
-    whose `calibration.discrepancy` is `discrepancy` (only "none": the verdict does not weigh a discrepancy term,
-    whose parameters the draws do not carry, so a study with one is refused rather than given a wrong verdict)."""
-
-    n_draws: int = 300
-    discrepancy: object = "none"
-
-    def __post_init__(self):
-        if int(self.n_draws) != self.n_draws or self.n_draws < MIN_DRAWS:
-            raise InputError(f"verify.n_draws: {self.n_draws!r} is not an integer >= {MIN_DRAWS}")
-        kind = self.discrepancy if self.discrepancy is None or isinstance(self.discrepancy, str) else (
-            self.discrepancy.get("kind") if isinstance(self.discrepancy, dict) else self.discrepancy.kind)
-        if kind not in (None, "none"):
-            raise InputError(f"calibration.discrepancy: {kind!r}: the hydrocode's verdict does not weigh a discrepancy "
-                             "term yet (its draws carry none); verify the study with `discrepancy: none`")
 
 
 @dataclass(frozen=True)
@@ -94,7 +73,7 @@ def psis_verdict(log_lik_hydrocode, log_lik_emulator) -> Verdict:
             draw (`Problem.hydrocode_log_likelihood`).
         log_lik_emulator: (S,) the log-likelihood the sampler used at the same draws (`Problem.log_likelihood`).
 
-    A length mismatch, fewer than MIN_DRAWS draws or a non-finite value is an InputError.
+    A length mismatch, fewer than MIN_VERIFY_DRAWS draws or a non-finite value is an InputError.
     """
     import arviz
 
@@ -103,8 +82,8 @@ def psis_verdict(log_lik_hydrocode, log_lik_emulator) -> Verdict:
     if hydro.shape != emulator.shape or hydro.ndim != 1:
         raise InputError(f"verify: {hydro.shape} hydrocode log-likelihoods against {emulator.shape} emulator ones; "
                          "give one of each per draw")
-    if len(hydro) < MIN_DRAWS:
-        raise InputError(f"verify: {len(hydro)} draws; PSIS needs at least {MIN_DRAWS}")
+    if len(hydro) < MIN_VERIFY_DRAWS:
+        raise InputError(f"verify: {len(hydro)} draws; PSIS needs at least {MIN_VERIFY_DRAWS}")
     bad = ~(np.isfinite(hydro) & np.isfinite(emulator))
     if bad.any():
         raise InputError(f"verify: draw {int(np.argmax(bad))}: a log-likelihood is not finite")

@@ -20,7 +20,7 @@ from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.simulators.builtin import DIAGNOSTICS, simulation_columns
 from shockcal.simulators.outputs import OutputError, OutputSpec, check_features, read_output
-from shockcal.velocimetry.features import COLUMNS as FEATURE_COLUMNS
+from shockcal.velocimetry.columns import COLUMNS as FEATURE_COLUMNS
 
 log = logging.getLogger("shockcal.simulators.archive")
 

@@ -43,7 +43,7 @@ from shockcal.progress import progress
 from shockcal.simulators.builtin import DIAGNOSTICS, simulation_columns
 from shockcal.simulators.outputs import OutputError, OutputSpec, read_output
 from shockcal.simulators.templates import command_values, render, run_values
-from shockcal.velocimetry.features import COLUMNS as FEATURE_COLUMNS
+from shockcal.velocimetry.columns import COLUMNS as FEATURE_COLUMNS
 
 log = logging.getLogger("shockcal.simulators.command")
 DONE = "done.json"

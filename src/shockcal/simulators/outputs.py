@@ -19,7 +19,7 @@ from shockcal.errors import InputError
 from shockcal.io import text_encoding
 from shockcal.plausibility import OTHER_UNITS, PLATEAU_RATIO, feature_problems
 from shockcal.units import VELOCITY_TO_M_S
-from shockcal.velocimetry.features import COLUMNS
+from shockcal.velocimetry.columns import COLUMNS
 
 TIME_TO_US = {"us": 1.0, "ns": 1.0e-3, "ms": 1.0e3, "s": 1.0e6}
 MIN_TRACE_POINTS = 50

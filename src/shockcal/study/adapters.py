@@ -314,8 +314,8 @@ def observed_table(config: dict) -> pd.DataFrame:
 
     from shockcal.errors import ConfigError
     from shockcal.plausibility import check_plateau
+    from shockcal.velocimetry.columns import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS
     from shockcal.velocimetry.feature_tables import record_features
-    from shockcal.velocimetry.features import COLUMNS, READOUT_COLUMNS, RECORD_NOISE_COLUMNS
 
     observed = config["observed"]
     if observed["source"] == "synthetic":

@@ -170,7 +170,7 @@ def check_next_shot(config: dict, source: str = "config") -> None:
         raise ConfigError(f"{source}: next_shot.shear_modulus_log_slope_per_K: min ({slope['min']:g}) is above max "
                           f"({slope['max']:g})")
     if section["readout_sd_m_s"]:
-        from shockcal.velocimetry.features import CALIBRATION_FEATURES
+        from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
         for feature in section["readout_sd_m_s"]:
             if feature not in CALIBRATION_FEATURES:

@@ -75,14 +75,14 @@ def apply_strength_model(config: dict, source: str) -> None:
                               f"(parameters: {', '.join(law.names())})")
     models_file = section.get("models_file", "config/models.yaml")
     file_box = _file_box(models_file, law.name, source) if any(
-        _calibrated(p) and p.name not in given for p in law.params) else {}
+        p.calibrated and p.name not in given for p in law.params) else {}
     box = {}
     for param in law.params:
         if param.name in given:
             low, high, where = given[param.name]["min"], given[param.name]["max"], f"strength.inputs.{param.name}"
         elif param.name in file_box:
             low, high, where = file_box[param.name].low, file_box[param.name].high, f"{models_file}: {law.name}.{param.name}"
-        elif _calibrated(param):
+        elif param.calibrated:
             raise ConfigError(f"{source}: strength.inputs.{param.name}: missing; {law.name} needs a box for it "
                               f"(give min and max, or a low/high in {models_file})")
         else:
@@ -96,11 +96,6 @@ def apply_strength_model(config: dict, source: str) -> None:
     cube = config["calibration"]["cube_power"]
     config["calibration"]["cube_power"] = {k: v for k, v in cube.items()
                                            if k in config["inputs"] or k not in DEFAULT_COLUMNS}
-
-
-def _calibrated(param) -> bool:
-    """A parameter that needs a box: neither a declared default nor a material constant."""
-    return param.default is None and param.material is None
 
 
 def material_constants(config: dict, model: str, boxed=(), source: str = "config") -> dict[str, float]:

@@ -13,9 +13,8 @@ import numpy as np
 from scipy import stats
 
 from shockcal.errors import InputError, ShockcalError
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES, COLUMNS
 from shockcal.velocimetry.features import (
-    CALIBRATION_FEATURES,
-    COLUMNS,
     ExtractorSettings,
     FeatureError,
     extract,

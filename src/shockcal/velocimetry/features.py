@@ -53,17 +53,13 @@ from scipy import optimize, stats
 from scipy.optimize import isotonic_regression
 from scipy.signal import savgol_filter
 
+from shockcal.velocimetry.columns import COLUMNS, FEATURES
 from shockcal.velocimetry.settings import ExtractorSettings
 
 if TYPE_CHECKING:
     import pandas as pd
 
 log = logging.getLogger("shockcal.velocimetry.features")
-FEATURES = ("jumpoff", "elastic", "plastic", "slope1", "slope2")
-COLUMNS = [f"{axis}_{name}" for name in FEATURES for axis in ("t", "v")]
-CALIBRATION_FEATURES = ["v_elastic", "v_plastic", "v_slope1", "v_slope2"]   # what the emulator and calibration use
-READOUT_COLUMNS = [f"readout_sd_{column}" for column in CALIBRATION_FEATURES]   # m/s, in the observed table
-RECORD_NOISE_COLUMNS = ["noise_sd_m_s", "noise_ar_order", "readout_half_window_ns"]
 ARRIVAL_FRACTION = 0.02
 QUIET_ARRIVAL_FRACTION = 0.002
 NOISE_MULTIPLE = 5.0

@@ -79,7 +79,7 @@ def check_given(law: Law, values: Mapping) -> None:
     bad = [k for k, v in values.items() if not _finite(v)]
     if bad:
         raise InputError(f"{law.name}: parameter {', '.join(bad)} is not a finite number")
-    missing = [p.name for p in law.params if p.name not in values and p.default is None and p.material is None]
+    missing = [p.name for p in law.params if p.name not in values and p.calibrated]
     if missing:
         raise InputError(f"{law.name}: missing parameter {', '.join(missing)}")
 

@@ -70,6 +70,11 @@ class Param:
     default: float | None = None
     material: str | None = None
 
+    @property
+    def calibrated(self) -> bool:
+        """A parameter a study must box: neither a declared default nor a material constant."""
+        return self.default is None and self.material is None
+
 
 def _p(name, field, unit, to_code, meaning, default=None, material=None) -> Param:
     return Param(name, field, unit, to_code, meaning, default, material)
@@ -149,7 +154,7 @@ class Law:
 
     def calibrated_columns(self) -> list[str]:
         """The columns of the parameters a study must box: neither a declared default nor a material constant."""
-        return [self.column(p) for p in self.params if p.default is None and p.material is None]
+        return [self.column(p) for p in self.params if p.calibrated]
 
     def role_column(self, role: str) -> str | None:
         """The column of the parameter that plays `role` (`roles`: "hardening_exponent", "rate_coefficient",
