@@ -8,6 +8,8 @@ from __future__ import annotations
 import ast
 import functools
 import graphlib
+import subprocess
+import sys
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "shockcal"
@@ -80,9 +82,6 @@ def test_a_simulate_job_loads_neither_the_feature_extractor_nor_scipy_stats():
     """The most numerous job of a study pays only for what it runs: what `shockcal simulate` imports (its
     command's imports and the built-in simulator) leaves out scipy.stats (1.7 CPU-s of a job's start,
     measured 2026-11-29) and scikit-learn, which a change of import placement could bring back."""
-    import subprocess
-    import sys
-
     tree = ast.parse((PACKAGE / "cli" / "simulate.py").read_text())
     modules = sorted({node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
                       and node.module.startswith("shockcal")} | {"shockcal.simulators.builtin"})
