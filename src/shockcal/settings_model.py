@@ -13,6 +13,7 @@ its physical rules), the emulator's and the extractor's build on it.
 from __future__ import annotations
 
 import difflib
+from types import UnionType
 from typing import Annotated, Literal, get_args, get_origin
 
 import annotated_types
@@ -79,6 +80,12 @@ class SettingsModel(BaseModel):
             raise PydanticCustomError("config_type", "not a number")
         return value
 
+    @classmethod
+    def from_section(cls, values: dict, **more):
+        """The model of a config section's `values`: the model's own fields the section gives (`section_fields`;
+        the keys of a section nested in it are another model's), and `more` (a field a key of its own gives)."""
+        return cls(**{name: values[name] for name in section_fields(cls) if name in values}, **more)
+
     def replace(self, **changes):
         """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
         return type(self)(**{**self.model_dump(), **changes})
@@ -125,12 +132,18 @@ def schema_properties(model: type[SettingsModel], required: list[str] = (), sect
 def _value_schema(annotation, metadata=()) -> dict:
     """A value's schema: `enum` for a Literal, `type` and the limits in `metadata` for a number, flag or text, a
     mapping of names to such values (`dict[str, Annotated[float, Field(ge=1, description=...)]]`) as an
-    object whose `additionalProperties` is the values' schema (with their description)."""
+    object whose `additionalProperties` is the values' schema (with their description), a list (`list[str]`) as
+    an array of its items' schema, a value or null (`str | None`) as the value's with the type null beside."""
     if get_origin(annotation) is Annotated:     # a value type with its Field (limits, description)
         value, info = get_args(annotation)
         return _value_schema(value, info.metadata) | ({"description": info.description} if info.description else {})
     if get_origin(annotation) is dict:
         return {"type": "object", "additionalProperties": _value_schema(get_args(annotation)[1])}
+    if get_origin(annotation) is list:
+        return {"type": "array", "items": _value_schema(get_args(annotation)[0])}
+    if get_origin(annotation) is UnionType and type(None) in get_args(annotation):   # a value or null
+        value = _value_schema(*(member for member in get_args(annotation) if member is not type(None)))
+        return value | {"type": [value["type"], "null"]}
     entry = {"enum": list(get_args(annotation))} if get_origin(annotation) is Literal else {"type": TYPES[annotation]}
     for limit in metadata:
         entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}

@@ -65,6 +65,7 @@ def register(subparsers) -> None:
 def run_wave_design(args) -> int:
     import logging
 
+    from shockcal.design.settings import WaveSettings
     from shockcal.design.waves import wave_design
     from shockcal.errors import InputError
     from shockcal.inference.posterior_files import companion_path
@@ -79,7 +80,7 @@ def run_wave_design(args) -> int:
     config = load_stage_config(args.config, "wave_design")
     if config["design"]["strategy"] != "waves":
         raise InputError(f"wave-design: design.strategy is {config['design']['strategy']!r}; waves need 'waves'")
-    sizes, waves = wave_sizes(config), config["design"]["waves"]
+    sizes, waves = wave_sizes(config), WaveSettings.from_section(config["design"]["waves"])
     if not 1 <= args.wave < len(sizes):
         raise InputError(f"--wave: {args.wave} is not a later wave of this study (1 to {len(sizes) - 1})")
     n_runs, stopped = sizes[args.wave], ""
@@ -93,20 +94,20 @@ def run_wave_design(args) -> int:
         shifts = quantile_shifts(before, after)
         log.info("joint posterior's 5/50/95%% points moved (combined Monte Carlo SE):\n%s",
                  shifts.to_string(index=False, float_format="%.2f"))
-        if posterior_settled(before, after, waves["stop_mcse"], user_box_widths(config), waves["stop_box"]):
-            stopped = (f"no 5/50/95% point moved by max({waves['stop_mcse']:g} combined Monte Carlo SE, "
-                       f"{waves['stop_box']:g} of its box) or more (design.waves.stop_mcse, stop_box)")
+        if posterior_settled(before, after, waves.stop_mcse, user_box_widths(config), waves.stop_box):
+            stopped = (f"no 5/50/95% point moved by max({waves.stop_mcse:g} combined Monte Carlo SE, "
+                       f"{waves.stop_box:g} of its box) or more (design.waves.stop_mcse, stop_box)")
     runs = load_study_design(args.runs, config, list(bounds))
     variance = None
-    if waves["criterion"] == "max_variance" and not stopped:
+    if waves.criterion == "max_variance" and not stopped:
         variance = max_variance_score(args, config)
     design = wave_design(posterior, bounds, 0 if stopped else n_runs,
                          int(runs["run"].max()) + 1, stream_seed(config["study"]["seed"], "waves", "pool", args.wave),
-                         existing=runs, widen=waves["widen"], pool_size=waves["pool_size"],
-                         criterion=waves["criterion"], variance=variance, source=args.posterior)
+                         existing=runs, widen=waves.widen, pool_size=waves.pool_size,
+                         criterion=waves.criterion, variance=variance, source=args.posterior)
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "units": units, "stopped": stopped,
-                                   "source": f"wave {args.wave}: {waves['criterion']} from {args.posterior}"})
+                                   "source": f"wave {args.wave}: {waves.criterion} from {args.posterior}"})
     log.info("wave %d: %s", args.wave, f"stopped, no runs: {stopped}" if stopped else
              f"{len(design)} runs (ids {design['run'].min()}-{design['run'].max()}) -> {args.out}")
     return 0
@@ -115,6 +116,7 @@ def run_wave_design(args) -> int:
 def run_new_shot_design(args) -> int:
     import logging
 
+    from shockcal.design.settings import WaveSettings
     from shockcal.design.waves import new_shot_design
     from shockcal.errors import InputError
     from shockcal.io import read_table, write_table
@@ -132,10 +134,11 @@ def run_new_shot_design(args) -> int:
     own = [name for name in inputs_read_by(config, [args.shot]) if name not in base]
     runs = load_study_design(args.runs, config, base)
     bounds, seed, section = prior_bounds(config), config["study"]["seed"], design_section["new_shots"]
+    waves = WaveSettings.from_section(design_section["waves"])
     design = new_shot_design(read_table(args.posterior), {n: bounds[n] for n in base}, {n: bounds[n] for n in own},
                              section["n_runs"], int(runs["run"].max()) + 1, stream_seed(seed, "new_shot", args.shot),
                              {n: stream_seed(seed, "new_shot", args.shot, n) for n in own}, existing=runs,
-                             widen=design_section["waves"]["widen"], pool_size=design_section["waves"]["pool_size"],
+                             widen=waves.widen, pool_size=waves.pool_size,
                              source=args.posterior)
     units = {name: config["inputs"][name]["unit"] for name in design.columns if name != "run"}
     write_table(design, args.out, {"table": "design", "units": units, "shot": args.shot,

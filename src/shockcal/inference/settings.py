@@ -73,6 +73,14 @@ class CheckSettings(SettingsModel):
     n_eff: int = setting(1000, "Effective sample size each trial's sampler runs to.", ge=MIN_N_EFF)
 
 
+class StepSamplerSettings(SettingsModel):
+    """The sampler of a sequential study's steps before the last (their joint posteriors only place the next
+    wave; the last step's is the study's, with `calibration`'s settings): `design.waves.step_calibration`."""
+
+    n_live: int = setting(250, "Live points of a step's joint calibration.", ge=MIN_N_LIVE)
+    n_eff: int = setting(1000, "The effective (Kish) sample size a step's joint calibration runs to.", ge=MIN_N_EFF)
+
+
 class DiscrepancySettings(SettingsModel):
     """The model-discrepancy term (`shockcal.inference.discrepancy`): the mapping form of the study config's
     `calibration.discrepancy` (its word form, `none`, is no term)."""

@@ -18,7 +18,6 @@ from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
 from shockcal.hydro.material_library import material_properties as library_material_properties
 from shockcal.inference.settings import CalibrationSettings, SamplerSettings
 from shockcal.seeds import stream_seed
-from shockcal.settings_model import section_fields
 from shockcal.study.config import (
     AUTO_END_MARGIN_US,
     PER_RUN_RISE_FRACTION,
@@ -131,8 +130,7 @@ def candidate_box(config: dict, name: str) -> InputBox:
 
 def emulator_settings(config: dict) -> EmulatorSettings:
     """`emulator` (the GP settings by name), seeded by study.seed."""
-    return EmulatorSettings(seed=config["study"]["seed"],
-                            **{name: config["emulator"][name] for name in section_fields(EmulatorSettings)})
+    return EmulatorSettings.from_section(config["emulator"], seed=config["study"]["seed"])
 
 
 def emulator_spec(config: dict, shots) -> EmulatorSpec:
@@ -167,7 +165,7 @@ def sampler_settings(config: dict, seed: int, check: bool = False) -> SamplerSet
     for both)."""
     section = config["calibration"]
     if not check:
-        return SamplerSettings(seed=seed, **{name: section[name] for name in section_fields(SamplerSettings)})
+        return SamplerSettings.from_section(section, seed=seed)
     trial = section["check"]
     return SamplerSettings(n_live=trial["n_live"], n_eff=trial["n_eff"], draws=trial["n_eff"], seed=seed,
                            cube_power=section["cube_power"], max_evaluations=section["max_evaluations"])

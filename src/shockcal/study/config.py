@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from shockcal.design.settings import WaveSettings
 from shockcal.errors import ConfigError
 from shockcal.units import MM_TO_CM, VELOCITY_TO_M_S, user_columns, user_units
 
@@ -163,15 +164,8 @@ def candidate_config(config: dict, name: str) -> dict:
 
 
 def wave_sizes(config: dict) -> list[int]:
-    """Runs per shot of each wave of a sequential study (`design.waves`): wave 0's `initial_runs`, then
-    `runs_per_wave` until `max_runs` is spent (the last wave takes the rest); [design.n_runs] for the
-    paper's design (`design.strategy: lhs`)."""
+    """Runs per shot of each wave of a sequential study (`WaveSettings.sizes`); [design.n_runs] for the paper's
+    design (`design.strategy: lhs`)."""
     design = config["design"]
-    if design["strategy"] != "waves":
-        return [design["n_runs"]]
-    waves = design["waves"]
-    sizes, left = [waves["initial_runs"]], waves["max_runs"] - waves["initial_runs"]
-    while left > 0:
-        sizes.append(min(waves["runs_per_wave"], left))
-        left -= sizes[-1]
-    return sizes
+    return WaveSettings.from_section(design["waves"]).sizes() if design["strategy"] == "waves" \
+        else [design["n_runs"]]

@@ -12,7 +12,7 @@ from pathlib import Path
 from shockcal.errors import ConfigError, InputError, number
 from shockcal.hydro import rules
 from shockcal.plausibility import check_observed, check_plateau, release_times_us
-from shockcal.settings_model import SettingsError, section_fields
+from shockcal.settings_model import SettingsError
 from shockcal.study.adapters import study_design
 from shockcal.study.config import candidate_config, shear_modulus_box_Mbar, velocity_box_m_s
 from shockcal.study.config_files import MODEL_SECTIONS
@@ -30,7 +30,7 @@ def check_model_sections(config: dict, source: str = "config") -> None:
             values = values.get(key) if isinstance(values, dict) else None
         if isinstance(values, dict):
             try:
-                model(**{name: values[name] for name in section_fields(model) if name in values})
+                model.from_section(values)
             except SettingsError as exc:
                 raise ConfigError(f"{source}: {section}.{exc.field}: {exc.reason}") from None
 
@@ -103,14 +103,10 @@ def check_semantics(config: dict, source: str = "config") -> None:
 
 
 def check_waves(config: dict, source: str = "config") -> None:
-    """A sequential study's budget holds wave 0 (`design.waves.max_runs` >= `initial_runs`), its wave 0 is a
-    Latin hypercube (no `design.file`), and its runs are made, not looked up (no `simulator.kind: archive`)."""
+    """A sequential study's wave 0 is a Latin hypercube (no `design.file`) and its runs are made, not looked up
+    (no `simulator.kind: archive`); `WaveSettings` checks that its budget holds wave 0."""
     if config["design"]["strategy"] != "waves":
         return
-    waves = config["design"]["waves"]
-    if waves["max_runs"] < waves["initial_runs"]:
-        raise ConfigError(f"{source}: design.waves.max_runs: {waves['max_runs']} is below wave 0's "
-                          f"design.waves.initial_runs ({waves['initial_runs']}); the budget must hold wave 0")
     if config["design"]["file"]:
         raise ConfigError(f"{source}: design.file: a design file and design.strategy: waves do not go together "
                           "(wave 0 is a Latin hypercube); set one of them")

@@ -21,10 +21,17 @@ from pathlib import Path
 
 import yaml
 
+from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.settings import HydroSettings
-from shockcal.inference.settings import CheckSettings, DiscrepancySettings, SamplerSettings, VerifySettings
+from shockcal.inference.settings import (
+    CheckSettings,
+    DiscrepancySettings,
+    SamplerSettings,
+    StepSamplerSettings,
+    VerifySettings,
+)
 from shockcal.settings_model import other_sections, schema_properties
 from shockcal.velocimetry.settings import ExtractorSettings
 
@@ -40,7 +47,9 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
 MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "features": ExtractorSettings,
                   "calibration": SamplerSettings, "calibration.check": CheckSettings,
-                  "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings}
+                  "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings, "design": DesignSettings,
+                  "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
+                  "design.waves.step_calibration": StepSamplerSettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
