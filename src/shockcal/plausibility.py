@@ -15,8 +15,28 @@ import logging
 import numpy as np
 
 from shockcal.errors import InputError
+from shockcal.settings_model import SettingsModel, setting
 
 log = logging.getLogger("shockcal.plausibility")
+
+
+class ChecksSettings(SettingsModel):
+    """Which plausibility checks run: the study config's `checks` section (docs/workflow.md, "Bad input and what
+    you get"); set one to false only to say that the values it rejects are intended."""
+
+    design_box: bool = setting(True, "Design points must lie inside the prior box (`inputs`).")
+    observed_units: bool = setting(True, "Observed features must look like m/s and microseconds.")
+    plateau_vs_velocity: bool = setting(
+        True, "A shot's measured plastic plateau (v_plastic) must lie in 0.85-1.05 x its impact-velocity box (in m/s): "
+        "a symmetric impact's plateau is about the impact velocity, so one far outside means the records of two shots "
+        "are swapped.")
+    features_in_training_range: bool = setting(
+        True, "Before a calibration, each measured calibration feature (m/s) must lie within its training runs' range, "
+        "widened on each side by a quarter of its width (docs/calibration.md, \"Measured features against the "
+        "training runs\"): a feature beyond it is one the emulator cannot reproduce (a misread record, another shot's "
+        "features, a prior box that misses the material), and its posterior would be the prior box. `shockcal "
+        "calibrate` stops in one line naming the shot, the feature, the value and the range; the synthetic-truth "
+        "checks' pseudo-measurements are only logged (false: measurements are only logged too).")
 
 # Plate-impact VISAR records (m/s, microseconds). A record as short as 10 ns still reads (the
 # extractor then says whether it holds a rise); seconds or milliseconds fail the time-step range.

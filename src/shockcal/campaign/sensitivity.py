@@ -28,6 +28,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 import pandas as pd
 
+from shockcal.campaign.settings import is_power_of_two
 from shockcal.errors import InputError
 
 COLUMNS = ["input", "S1", "S1_conf", "ST", "ST_conf"]
@@ -62,7 +63,7 @@ def sobol_indices(function: Callable[[np.ndarray], np.ndarray], names: list[str]
     if not np.all(upper > lower):
         bad = [n for n, lo, hi in zip(names, lower, upper) if not hi > lo]
         raise InputError(f"Sobol indices: empty box for inputs {bad} (upper must exceed lower)")
-    if n_base < 2 or n_base & (n_base - 1):
+    if not is_power_of_two(n_base):
         raise InputError(f"Sobol indices: n_base {n_base} is not a power of 2 (Sobol sequences balance only then)")
     problem = {"num_vars": len(names), "names": list(names), "bounds": np.column_stack([lower, upper]).tolist()}
     points = sample.sample(problem, n_base, calc_second_order=False, scramble=True, seed=seed)

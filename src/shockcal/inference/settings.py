@@ -10,6 +10,8 @@ from typing import Annotated, Literal
 from pydantic import Field, field_validator
 from pydantic_core import PydanticCustomError
 
+from shockcal.hydro.settings_model import SettingsModel as RuledSettingsModel
+from shockcal.hydro.settings_model import setting as ruled_setting
 from shockcal.settings_model import SettingsModel, setting
 
 MIN_N_LIVE = 50          # the least live points of every sampler (calibration, its check, the next-shot check)
@@ -132,6 +134,16 @@ class CalibrationSettings(SettingsModel):
     def with_sampler(self, **changes) -> CalibrationSettings:
         """These settings with some sampler settings changed (e.g. `seed`, `n_eff`), checked."""
         return self.replace(sampler=self.sampler.replace(**changes))
+
+
+class PredictSettings(RuledSettingsModel):
+    """Posterior predictions (Figures 10-13): the hydrocode run at joint-posterior draws, the study config's
+    `predict` section (`shockcal predict-design`; the predict run set's simulate jobs)."""
+
+    n_posterior_runs: int = setting(100, "Joint-posterior draws run through the hydrocode for every shot.", ge=1)
+    end_time_us: float = ruled_setting(
+        4.0, "Simulated time of those runs, the whole record for the history figures. The workflow hands it to the "
+        "predict run set's simulate jobs (`--end-time-us`): a change reruns them.", rule="positive")
 
 
 class VerifySettings(SettingsModel):

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import yaml
 
+from shockcal.campaign.settings import SensitivitySettings
 from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
@@ -28,11 +29,15 @@ from shockcal.hydro.settings import HydroSettings
 from shockcal.inference.settings import (
     CheckSettings,
     DiscrepancySettings,
+    PredictSettings,
     SamplerSettings,
     StepSamplerSettings,
     VerifySettings,
 )
+from shockcal.plausibility import ChecksSettings
+from shockcal.plots.settings import FigureSettings
 from shockcal.settings_model import other_sections, schema_properties
+from shockcal.simulators.settings import SimulateSettings
 from shockcal.velocimetry.settings import ExtractorSettings
 
 EXTENDS = "extends"
@@ -49,7 +54,9 @@ MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "feature
                   "calibration": SamplerSettings, "calibration.check": CheckSettings,
                   "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings, "design": DesignSettings,
                   "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
-                  "design.waves.step_calibration": StepSamplerSettings}
+                  "design.waves.step_calibration": StepSamplerSettings, "checks": ChecksSettings,
+                  "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
+                  "figures": FigureSettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
