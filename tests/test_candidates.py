@@ -101,9 +101,12 @@ def _candidate(**changes) -> dict:
         ({"candidates": {"x": _candidate(flyer_mm=1.0, target_mm=12.0)}},
          r"next_shot\.candidates\.x: the plastic wave reaches the free surface .* too thin for a plateau"),
         ({"candidates": {"x": _candidate(velocity_m_s=-5)}}, r"next_shot\.candidates\.x\.velocity_m_s: -5"),
-        ({"readout_sd_m_s": {"t_elastic": 1.0}}, r"next_shot\.readout_sd_m_s\.t_elastic: not a calibration feature"),
+        ({"readout_sd_m_s": {"t_elastic": 1.0}}, r"next_shot\.readout_sd_m_s: t_elastic: not a calibration feature"),
         ({"shear_modulus_log_slope_per_K": {"min": 0.0, "max": -1e-3}},
-         r"next_shot\.shear_modulus_log_slope_per_K: min \(0\) is above max"),
+         r"next_shot\.shear_modulus_log_slope_per_K\.max: -0\.001 is below min \(0\)"),
+        ({"targets": ["m", "m"]}, r"next_shot\.targets: \['m', 'm'\] names a target twice"),
+        ({"check": {"candidates": ["104S-repeat", "104S-repeat"]}},
+         r"next_shot\.check\.candidates: compares 104S-repeat with itself"),
     ],
 )
 def test_bad_candidates_are_named_before_any_run(paper_config, change, message):

@@ -26,7 +26,8 @@ KEY = "x-key"            # a field the config gives by a key of its own (e.g. `s
 SECTION = "x-section"    # a field that is a key of another config section than the model's own (generated there)
 TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", int | float: "number"}
 LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exclusiveMinimum"),
-          (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"))
+          (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"),
+          (annotated_types.MinLen, "min_length", "minItems"), (annotated_types.MaxLen, "max_length", "maxItems"))
 
 
 def setting(default, description: str, unit: str | None = None, key: str | None = None, section: str | None = None,
@@ -35,7 +36,7 @@ def setting(default, description: str, unit: str | None = None, key: str | None 
     does not say it, the config `key` that gives it when no section of the model's holds it (e.g.
     `study.seed`: not generated), the config `section` it is a key of when that is not the model's own
     (dotted, `*` for every key of a mapping: `shots.*.analysis`; generated there), further schema keywords
-    `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt)."""
+    `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt; a list's min_length, max_length)."""
     schema = {name: value for name, value in (("x-unit", unit), (KEY, key), (SECTION, section)) if value is not None}
     return Field(default, description=description, json_schema_extra=(schema | (extra or {})) or None, **limits)
 
@@ -138,13 +139,16 @@ def _value_schema(annotation, metadata=()) -> dict:
         value, info = get_args(annotation)
         return _value_schema(value, info.metadata) | ({"description": info.description} if info.description else {})
     if get_origin(annotation) is dict:
-        return {"type": "object", "additionalProperties": _value_schema(get_args(annotation)[1])}
-    if get_origin(annotation) is list:
-        return {"type": "array", "items": _value_schema(get_args(annotation)[0])}
-    if get_origin(annotation) is UnionType and type(None) in get_args(annotation):   # a value or null
-        value = _value_schema(*(member for member in get_args(annotation) if member is not type(None)))
-        return value | {"type": [value["type"], "null"]}
-    entry = {"enum": list(get_args(annotation))} if get_origin(annotation) is Literal else {"type": TYPES[annotation]}
+        entry = {"type": "object", "additionalProperties": _value_schema(get_args(annotation)[1])}
+    elif get_origin(annotation) is list:
+        entry = {"type": "array", "items": _value_schema(get_args(annotation)[0])}
+    elif get_origin(annotation) is UnionType and type(None) in get_args(annotation):   # a value or null
+        entry = _value_schema(*(member for member in get_args(annotation) if member is not type(None)))
+        entry |= {"type": [entry["type"], "null"]}
+    elif get_origin(annotation) is Literal:
+        entry = {"enum": list(get_args(annotation))}
+    else:
+        entry = {"type": TYPES[annotation]}
     for limit in metadata:
         entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
     return entry

@@ -21,7 +21,12 @@ from pathlib import Path
 
 import yaml
 
-from shockcal.campaign.settings import SensitivitySettings
+from shockcal.campaign.settings import (
+    ModulusSlopeSettings,
+    NextShotCheckSettings,
+    NextShotSettings,
+    SensitivitySettings,
+)
 from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
@@ -56,7 +61,8 @@ MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "feature
                   "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
                   "design.waves.step_calibration": StepSamplerSettings, "checks": ChecksSettings,
                   "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
-                  "figures": FigureSettings}
+                  "figures": FigureSettings, "next_shot": NextShotSettings,
+                  "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings, "next_shot.check": NextShotCheckSettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
