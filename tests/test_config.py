@@ -141,6 +141,7 @@ SETTINGS = [
     ("shockcal.campaign.settings:NextShotSettings", ["next_shot"], {}, False),
     ("shockcal.campaign.settings:ModulusSlopeSettings", ["next_shot.shear_modulus_log_slope_per_K"], {}, True),
     ("shockcal.campaign.settings:NextShotCheckSettings", ["next_shot.check"], {}, True),
+    ("shockcal.velocimetry.settings:ObservedSettings", ["observed"], {}, False),
     ("shockcal.simulators.command:CommandSettings", ["simulator.command"], {}, False),
     ("shockcal.simulators.outputs:OutputSpec", ["#run_output"], {}, True),
     ("shockcal.campaign.candidates:Candidate", ["next_shot.candidates.*", "#candidate"], {}, False),

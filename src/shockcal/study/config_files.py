@@ -43,7 +43,7 @@ from shockcal.plausibility import ChecksSettings
 from shockcal.plots.settings import FigureSettings
 from shockcal.settings_model import other_sections, schema_properties
 from shockcal.simulators.settings import SimulateSettings
-from shockcal.velocimetry.settings import ExtractorSettings
+from shockcal.velocimetry.settings import ExtractorSettings, ObservedSettings
 
 EXTENDS = "extends"
 SCHEMA_PATH = Path(__file__).parents[1] / "config.schema.yaml"
@@ -62,7 +62,8 @@ MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "feature
                   "design.waves.step_calibration": StepSamplerSettings, "checks": ChecksSettings,
                   "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
                   "figures": FigureSettings, "next_shot": NextShotSettings,
-                  "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings, "next_shot.check": NextShotCheckSettings}
+                  "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings, "next_shot.check": NextShotCheckSettings,
+                  "observed": ObservedSettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
