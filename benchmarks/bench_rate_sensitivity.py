@@ -1,5 +1,5 @@
 """How far a rounding-level perturbation moves a trace, against the Johnson-Cook rate coefficient C:
-printed, never asserted (docs/hydro.md, "Rounding sensitivity").
+printed, never asserted (docs/hydro.md, "Rounding and time step").
 
 One 106S run (A = 840 MPa, B = 821 MPa, n = 0.46, m = 2.26, G = 30 GPa, nominal velocity) is run
 twice per C and CFL number: as is, and with the impact velocity raised by one part in 1e12. The

@@ -2,7 +2,7 @@
 `--replicates` independent sampler runs pooled (the quantiles' Monte Carlo SE from their spread,
 `calibration.replicates`), and every input's 5/50/95% points are compared: the difference against
 max(3 combined Monte Carlo SE, `--box-fraction` of the prior box), the sequential design's acceptance
-(docs/sequential.md, "The sequential study against the paper design").
+(docs/sequential.md, "The sequential study at full size").
 
     python benchmarks/posterior_agreement.py --studies results results/sequential [--replicates 3] \
         [--work /tmp/posterior_agreement]

@@ -38,7 +38,7 @@ class DesignSettings(SettingsModel):
 
 class NewShotSettings(SettingsModel):
     """Where the runs of a shot outside `design.base_shots` (a shot added to the study) come from
-    (`shockcal.design.waves.new_shot_design`; docs/workflow.md, "Adding a shot")."""
+    (`shockcal.design.waves.new_shot_design`; docs/workflow.md, "How to add a shot")."""
 
     runs_from: Literal["posterior", "training"] = setting(
         "posterior", "`posterior`: `n_runs` runs of its own, the base shots' joint posterior thinned for space filling "

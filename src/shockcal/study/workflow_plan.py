@@ -66,7 +66,7 @@ class WorkflowPlan:
     results: str
     shots: list[str]
     candidates: list[str]  # next_shot.candidates: the run set next_shot's "shots"
-    new_shots: list[str]  # design.new_shots placed from the base shots' posterior (docs/workflow.md, "Adding a shot")
+    new_shots: list[str]  # design.new_shots, from the base shots' posterior (docs/workflow.md, "How to add a shot")
     base_shots: list[str]
     base_study: dict  # the study without its new shots (the config itself when there are none)
     effective_text: str  # the merged config every job reads ($SHOCKCAL_CONFIG)

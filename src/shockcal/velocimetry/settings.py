@@ -46,7 +46,7 @@ class ObservedSettings(SettingsModel):
     readout_error: bool = setting(
         True, "With source `records`: estimate each feature's read-out sd on its record, the spread of the extractor's "
         "value over replicates of the record's own noise (an AR model fitted to its plateau; docs/features.md, "
-        "\"Read-out error\"), seeded by the `readout` stream of study.seed. It is written with the observed features "
+        "\"Noisy traces\"), seeded by the `readout` stream of study.seed. It is written with the observed features "
         "(`readout_sd_v_*`, m/s) and enters each feature's observation variance beside `sd_fraction`. false: 0 (the "
         "1% alone, as before 2026-11-26).")
     readout_replicates: int = setting(
