@@ -142,6 +142,7 @@ SETTINGS = [
     ("shockcal.campaign.settings:ModulusSlopeSettings", ["next_shot.shear_modulus_log_slope_per_K"], {}, True),
     ("shockcal.campaign.settings:NextShotCheckSettings", ["next_shot.check"], {}, True),
     ("shockcal.velocimetry.settings:ObservedSettings", ["observed"], {}, False),
+    ("shockcal.hydro.laws.settings:StrengthSettings", ["strength"], {}, False),
     ("shockcal.simulators.command:CommandSettings", ["simulator.command"], {}, False),
     ("shockcal.simulators.outputs:OutputSpec", ["#run_output"], {}, True),
     ("shockcal.campaign.candidates:Candidate", ["next_shot.candidates.*", "#candidate"], {}, False),

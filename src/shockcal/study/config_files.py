@@ -30,6 +30,7 @@ from shockcal.campaign.settings import (
 from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
+from shockcal.hydro.laws.settings import StrengthSettings
 from shockcal.hydro.settings import HydroSettings
 from shockcal.inference.settings import (
     CheckSettings,
@@ -63,7 +64,7 @@ MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "feature
                   "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
                   "figures": FigureSettings, "next_shot": NextShotSettings,
                   "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings, "next_shot.check": NextShotCheckSettings,
-                  "observed": ObservedSettings}
+                  "observed": ObservedSettings, "strength": StrengthSettings}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
