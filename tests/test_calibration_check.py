@@ -151,7 +151,9 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
     density: the trial's truth_hpd_mass is empty (the joint check is skipped), its per-parameter intervals are
     there as without one."""
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    settings = _settings(paper_config, 100, 300).replace(discrepancy={"kind": "feature_kind"})
+    # the sampler's least settings: what is checked (an empty joint mass, ordered intervals, the parameters)
+    # does not depend on the run's size
+    settings = _settings(paper_config, 50, 100).replace(discrepancy={"kind": "feature_kind"})
     trials = synthetic_truth(emu, ["toy"], settings, trials=1, seed=4)
     assert (trials["status"] == "ok").all() and trials["truth_hpd_mass"].isna().all()
     assert (trials["q05"] < trials["q95"]).all() and set(trials["parameter"]) == {*emu.required_inputs(["toy"]), "lambda_y"}
@@ -409,7 +411,9 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     from shockcal.cli import main
     from shockcal.io import read_table_metadata
 
-    small_config["calibration"]["draws"] = 1000
+    # the sampler's least settings: what is checked (the files, their units and names, quantiles inside the box,
+    # the refusals) does not depend on the run's size
+    small_config["calibration"].update(n_live=50, n_eff=100, draws=1000)
     config_path = tmp_path / "config.yaml"
     config_path.write_text(yaml.safe_dump(small_config))
     emu = ShotEmulator(small_config)
