@@ -161,7 +161,9 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
 
 def test_failed_trials_are_recorded_with_their_reason_not_the_end_of_the_batch(paper_config):
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    starved = _settings(paper_config, 100, 3000).with_sampler(max_evaluations=1000)     # the least the config takes
+    # max_evaluations 1000 is the least the config takes; 500 live points spend them on one or two bounds (100 took
+    # ten networks per trial), and no run of 1000 evaluations reaches an ESS of 3000 whatever its live points
+    starved = _settings(paper_config, 500, 3000).with_sampler(max_evaluations=1000)
     trials = synthetic_truth(emu, ["toy"], starved, trials=2, seed=4)
     assert len(trials) == 2 * 3 and sorted(trials["trial"].unique()) == [0, 1]
     assert (trials["status"] == "failed").all() and trials["reason"].str.contains("max_evaluations").all()
