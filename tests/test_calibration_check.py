@@ -151,7 +151,9 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
     density: the trial's truth_hpd_mass is empty (the joint check is skipped), its per-parameter intervals are
     there as without one."""
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    settings = _settings(paper_config, 100, 300).replace(discrepancy={"kind": "feature_kind"})
+    # the sampler's least settings: what is checked (an empty joint mass, ordered intervals, the parameters)
+    # does not depend on the run's size
+    settings = _settings(paper_config, 50, 100).replace(discrepancy={"kind": "feature_kind"})
     trials = synthetic_truth(emu, ["toy"], settings, trials=1, seed=4)
     assert (trials["status"] == "ok").all() and trials["truth_hpd_mass"].isna().all()
     assert (trials["q05"] < trials["q95"]).all() and set(trials["parameter"]) == {*emu.required_inputs(["toy"]), "lambda_y"}
@@ -159,7 +161,9 @@ def test_a_discrepancy_leaves_the_joint_mass_empty_and_keeps_the_intervals(paper
 
 def test_failed_trials_are_recorded_with_their_reason_not_the_end_of_the_batch(paper_config):
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
-    starved = _settings(paper_config, 100, 3000).with_sampler(max_evaluations=1000)     # the least the config takes
+    # max_evaluations 1000 is the least the config takes; 500 live points spend them on one or two bounds (100 took
+    # ten networks per trial), and no run of 1000 evaluations reaches an ESS of 3000 whatever its live points
+    starved = _settings(paper_config, 500, 3000).with_sampler(max_evaluations=1000)
     trials = synthetic_truth(emu, ["toy"], starved, trials=2, seed=4)
     assert len(trials) == 2 * 3 and sorted(trials["trial"].unique()) == [0, 1]
     assert (trials["status"] == "failed").all() and trials["reason"].str.contains("max_evaluations").all()
@@ -409,7 +413,9 @@ def test_cli_writes_samples_and_summary_and_rejects_other_emulator_versions(smal
     from shockcal.cli import main
     from shockcal.io import read_table_metadata
 
-    small_config["calibration"]["draws"] = 1000
+    # the sampler's least settings: what is checked (the files, their units and names, quantiles inside the box,
+    # the refusals) does not depend on the run's size
+    small_config["calibration"].update(n_live=50, n_eff=100, draws=1000)
     config_path = tmp_path / "config.yaml"
     config_path.write_text(yaml.safe_dump(small_config))
     emu = ShotEmulator(small_config)

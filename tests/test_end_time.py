@@ -29,13 +29,29 @@ def test_auto_end_time_is_the_window_end_bound(paper_config):
 
 
 CORNERS = [3, 4]    # the runs of reference_design whose free surface moves latest
+EARLY = [0]         # the hypercube run the fast suite's `per_run` check compares
+
+
+@pytest.fixture(scope="module")
+def auto_fast_runs(paper_config_readonly) -> pd.DataFrame:
+    """`auto`'s features of the corners and the early run, simulated once for the two fast tests that read them
+    (each run is simulated and read on its own: the same rows as a batch of its runs alone)."""
+    return features_at(paper_config_readonly, "auto", EARLY + CORNERS).set_index(["shot", "run"]).sort_index()
+
+
+def _auto_features(config, runs, request) -> pd.DataFrame:
+    """`auto`'s features of `runs` (None: all), by shot and run: the module's shared runs where they hold them."""
+    if runs is None:
+        return features_at(config, "auto", runs).set_index(["shot", "run"]).sort_index()
+    shared = request.getfixturevalue("auto_fast_runs")
+    return shared[shared.index.get_level_values("run").isin(runs)]
 
 
 @pytest.mark.parametrize("runs", [pytest.param(CORNERS, id="corners"),
                                   pytest.param(None, id="all", marks=pytest.mark.slow)])
-def test_auto_end_time_keeps_every_feature(paper_config, runs):
+def test_auto_end_time_keeps_every_feature(paper_config, runs, request):
     reference = pd.read_csv(OUT).set_index(["shot", "run"]).sort_index()
-    auto = features_at(paper_config, "auto", runs).set_index(["shot", "run"]).sort_index()
+    auto = _auto_features(paper_config, runs, request)
     reference = reference.loc[auto.index]
     assert (auto["status"] == "ok").all(), auto.loc[auto["status"] != "ok", "reason"]
     speeds = [c for c in reference.columns if c.startswith("v_")]
@@ -79,9 +95,9 @@ def test_a_stop_after_the_rise_needs_both_settings():
         Geometry(3.95, 5.965, 2.3, stop_after_rise_us=1.2, rise_fraction=-0.1)
 
 
-@pytest.mark.parametrize("runs", [pytest.param([0], id="early"),
+@pytest.mark.parametrize("runs", [pytest.param(EARLY, id="early"),
                                   pytest.param(None, id="all", marks=pytest.mark.slow)])
-def test_per_run_end_keeps_the_auto_runs_features(paper_config, runs):
+def test_per_run_end_keeps_the_auto_runs_features(paper_config, runs, request):
     """`per_run` ends each run the window plus 0.1 us after its free surface passes 0.3% of its impact velocity,
     no later than the extractor's arrival (its threshold on a trace at rest is 0.2% of the rise, and the rise
     stays below 1.5x the impact velocity): the features equal `auto`'s bit for bit, on a hypercube run (cut
@@ -91,7 +107,7 @@ def test_per_run_end_keeps_the_auto_runs_features(paper_config, runs):
     from shockcal.velocimetry.features import QUIET_ARRIVAL_FRACTION
 
     assert PER_RUN_RISE_FRACTION == pytest.approx(1.5 * QUIET_ARRIVAL_FRACTION)
-    auto = features_at(paper_config, "auto", runs).set_index(["shot", "run"]).sort_index()
+    auto = _auto_features(paper_config, runs, request)
     per_run = features_at(paper_config, "per_run", runs).set_index(["shot", "run"]).sort_index()
     assert (per_run["status"] == "ok").all(), per_run.loc[per_run["status"] != "ok", "reason"]
     columns = [c for c in auto.columns if c.startswith(("t_", "v_"))]

@@ -193,7 +193,9 @@ def test_truth_lambda_y_and_shared_noise_in_calibrate_check(paper_config):
     from shockcal.inference.coverage import HydroTruths, synthetic_truth
     from shockcal.study.adapters import calibration_settings
 
-    paper_config["calibration"]["check"].update(n_live=100, n_eff=200)
+    # the sampler's least settings: what is checked (the truths' lambda_y and runs, the draws' columns) does
+    # not depend on the run's size
+    paper_config["calibration"]["check"].update(n_live=50, n_eff=100)
     emu = ShotEmulator(paper_config, shots=["toy"], emulator_sd=0.3)
     mean, _ = emu.predict({"A": np.array([0.004, 0.006]), "n": np.array([0.5, 0.7])}, ["toy"])
     design = pd.DataFrame({"run": [7, 9], "A": [0.004, 0.006], "n": [0.5, 0.7], "lambda_y": [0.8, 1.3]})

@@ -14,7 +14,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
-from test_workflow import overlay, pending_jobs, snakemake
+from test_workflow import job_counts, overlay, pending_jobs, snakemake
 
 REPO = Path(__file__).resolve().parents[1]
 SEQUENTIAL = REPO / "config" / "sequential-quick.yaml"
@@ -26,10 +26,21 @@ def waves_overlay(path: Path, results: Path, max_runs: int = 50, **waves) -> Pat
                    design={"waves": {"initial_runs": 30, "runs_per_wave": 10, "max_runs": max_runs, **waves}})
 
 
+@pytest.fixture(scope="module")
+def two_wave_dry_run(tmp_path_factory) -> str:
+    """The output of a dry run of the toy sequential study (max_runs 50: waves 1 and 2) into a fresh results
+    directory, run once for the two tests that read its plan (job counts, priorities)."""
+    root = tmp_path_factory.mktemp("two-waves")
+    config = waves_overlay(root / "waves.yaml", root / "results")
+    return snakemake("all", "--dry-run", config_files=[SEQUENTIAL, config]).stdout
+
+
 @pytest.mark.parametrize("max_runs, waves", [(30, 0), (50, 2)])
-def test_each_wave_is_a_run_set_with_its_refit_and_recalibration(tmp_path, max_runs, waves):
-    config = waves_overlay(tmp_path / "waves.yaml", tmp_path / "results", max_runs)
-    jobs = pending_jobs(SEQUENTIAL, config)
+def test_each_wave_is_a_run_set_with_its_refit_and_recalibration(tmp_path, max_runs, waves, request):
+    if max_runs == 50:          # waves_overlay's default: the module's dry run
+        jobs = job_counts(request.getfixturevalue("two_wave_dry_run"))
+    else:
+        jobs = pending_jobs(SEQUENTIAL, waves_overlay(tmp_path / "waves.yaml", tmp_path / "results", max_runs))
     assert jobs["simulate"] == SHOTS * 3                      # wave 0: the training run set, 30 runs in chunks of 10
     for k in range(1, waves + 1):
         assert jobs[f"simulate[wave{k}]"] == SHOTS             # 10 runs: one chunk per shot
@@ -41,11 +52,10 @@ def test_each_wave_is_a_run_set_with_its_refit_and_recalibration(tmp_path, max_r
     assert jobs["emulator"] == 1 and jobs["calibrate"] == SHOTS + 1                  # the study's, on every run
 
 
-def test_each_run_sets_longest_hydrocode_chunk_starts_first(tmp_path):
+def test_each_run_sets_longest_hydrocode_chunk_starts_first(two_wave_dry_run):
     """105S (the thickest target, the longest record) costs 1.9 times 104S's per run: its chunk of each wave
     gets the highest priority, so it does not start last and leave a core idle."""
-    config = waves_overlay(tmp_path / "waves.yaml", tmp_path / "results")
-    out = snakemake("all", "--dry-run", config_files=[SEQUENTIAL, config]).stdout
+    out = two_wave_dry_run
     priority = {}
     for block in re.split(r"^(?=(?:local)?rule \S+:$)", out, flags=re.MULTILINE)[1:]:
         if re.match(r"(?:local)?rule simulate:", block):
