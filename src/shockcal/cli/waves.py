@@ -73,14 +73,15 @@ def run_wave_design(args) -> int:
     from shockcal.io import read_table, write_table
     from shockcal.seeds import stream_seed
     from shockcal.study.adapters import load_study_design
-    from shockcal.study.config import prior_bounds, user_box_widths, wave_sizes
+    from shockcal.study.config import prior_bounds, user_box_widths
     from shockcal.study.stages import load_stage_config
 
     log = logging.getLogger("shockcal.design.waves")
     config = load_stage_config(args.config, "wave_design")
     if config["design"]["strategy"] != "waves":
         raise InputError(f"wave-design: design.strategy is {config['design']['strategy']!r}; waves need 'waves'")
-    sizes, waves = wave_sizes(config), WaveSettings.from_section(config["design"]["waves"])
+    waves = WaveSettings.from_section(config["design"]["waves"])
+    sizes = waves.sizes()
     if not 1 <= args.wave < len(sizes):
         raise InputError(f"--wave: {args.wave} is not a later wave of this study (1 to {len(sizes) - 1})")
     n_runs, stopped = sizes[args.wave], ""
