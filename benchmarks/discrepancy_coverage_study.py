@@ -21,7 +21,6 @@ Student-t block is refused by the discrepancy): pass an emulator fitted with `em
 
 import argparse
 import time
-from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -72,7 +71,7 @@ def run(args):
     truths = read_table(args.truths_from)
     shift_sd = shift_sd_m_s(read_table(args.observed), shots, args.shift_ns)
     disc = Discrepancy(tuple(features), len(shots), args.sd_fraction_prior)
-    base = replace(calibration_settings(config, shots), check_training_range=False, check_plateau=False,
+    base = calibration_settings(config, shots).replace(check_training_range=False, check_plateau=False,
                    velocity_boxes={}, check_units=False)
     rng = np.random.default_rng(args.seed)
     runs = {"none": "none", "feature_kind": {"kind": "feature_kind", "sd_fraction_prior": args.sd_fraction_prior}}
@@ -86,7 +85,7 @@ def run(args):
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=features).assign(shot=shots)
         seed = int(rng.integers(2**31))
         for kind, setting in runs.items():
-            settings = replace(base, discrepancy=setting).with_sampler(n_live=args.n_live, n_eff=args.n_eff,
+            settings = base.replace(discrepancy=setting).with_sampler(n_live=args.n_live, n_eff=args.n_eff,
                                                                         draws=args.n_eff, seed=seed)
             start = time.process_time()
             posterior = calibrate(emulator, shots, observed, settings, f"trial {trial}")
