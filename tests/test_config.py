@@ -218,9 +218,9 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
 @pytest.mark.parametrize("section", sorted(MODEL_SECTIONS))
 def test_a_settings_models_section_of_the_schema_is_generated_from_it(section):
     """One definition: each field of the section's model is a schema key with the model's default (unless the
-    section requires the key), description and rule, in its own section or the one it names (ExtractorSettings'
+    section requires the key or the field is optional), description and rule, in its own section or the one it names (ExtractorSettings'
     analysis window: `shots.*.analysis`), and the YAML file names none of them."""
-    from shockcal.settings_model import KEY, SECTION, other_sections, section_fields
+    from shockcal.settings_model import KEY, OPTIONAL, SECTION, other_sections, section_fields
     from shockcal.study.config_files import SCHEMA_PATH, load_schema, section_schema
 
     schema, model = load_schema(), MODEL_SECTIONS[section]
@@ -238,7 +238,7 @@ def test_a_settings_models_section_of_the_schema_is_generated_from_it(section):
         assert key["description"] == field.description and field.description
         assert key.get("x-rule") == extra.get("x-rule")
         assert key.get("x-unit") == extra.get("x-unit")
-        if name in node.get("required", []):
+        if name in node.get("required", []) or extra.get(OPTIONAL):     # required, or left out: not given
             assert "default" not in key
         else:
             assert key["default"] == field.default
