@@ -165,4 +165,6 @@ def _value_schema(annotation, metadata=()) -> dict:
         entry = {"type": TYPES[annotation]}
     for limit in metadata:
         entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+    if entry.get("type") == "string":        # a text's length limits: JSON Schema's words for a text
+        entry |= {f"{end}Length": entry.pop(f"{end}Items") for end in ("min", "max") if f"{end}Items" in entry}
     return entry

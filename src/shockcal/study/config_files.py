@@ -43,6 +43,8 @@ from shockcal.inference.settings import (
 from shockcal.plausibility import ChecksSettings
 from shockcal.plots.settings import FigureSettings
 from shockcal.settings_model import other_sections, schema_properties
+from shockcal.simulators.command import CommandSettings
+from shockcal.simulators.outputs import OutputSpec
 from shockcal.simulators.settings import SimulateSettings
 from shockcal.velocimetry.settings import ExtractorSettings, ObservedSettings
 
@@ -64,7 +66,8 @@ MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "emula
                   "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
                   "figures": FigureSettings, "next_shot": NextShotSettings,
                   "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings,
-                  "next_shot.check": NextShotCheckSettings, "observed": ObservedSettings, "strength": StrengthSettings}
+                  "next_shot.check": NextShotCheckSettings, "observed": ObservedSettings, "strength": StrengthSettings,
+                  "simulator.command": CommandSettings, "definitions.run_output": OutputSpec}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
@@ -80,10 +83,13 @@ def _schema_text_parsed() -> dict:
 
 
 def section_schema(schema: dict, section: str) -> dict:
-    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`); of
+    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`;
+    `definitions.<name>`: a shared entry); of
     a key that is a mapping or something else (`oneOf`), its mapping form's."""
-    entry = schema
-    for part in section.split("."):
+    entry, parts = schema, section.split(".")
+    if parts[0] == "definitions":     # a shared entry (`definitions.run_output`), which sections `$ref`
+        entry, parts = schema["definitions"][parts[1]], parts[2:]
+    for part in parts:
         entry = entry["additionalProperties"] if part == "*" else entry["properties"][part]
     return next((option for option in entry["oneOf"] if option.get("type") == "object"), entry) if "oneOf" in entry \
         else entry
