@@ -218,27 +218,29 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
 @pytest.mark.parametrize("section", sorted(MODEL_SECTIONS))
 def test_a_settings_models_section_of_the_schema_is_generated_from_it(section):
     """One definition: each field of the section's model is a schema key with the model's default (unless the
-    section requires the key), description and rule, in its own section or the one it names (ExtractorSettings'
+    section requires the key or the field is optional), description and rule, in its own section or the one it names (ExtractorSettings'
     analysis window: `shots.*.analysis`), and the YAML file names none of them."""
-    from shockcal.settings_model import KEY, SECTION, other_sections, section_fields
+    from shockcal.settings_model import KEY, OPTIONAL, SECTION, other_sections, section_fields
     from shockcal.study.config_files import SCHEMA_PATH, load_schema, section_schema
 
     schema, model = load_schema(), MODEL_SECTIONS[section]
     for where in [section, *other_sections(model)]:
         written = section_schema(yaml.safe_load(SCHEMA_PATH.read_text()), where)["properties"]
-        assert not set(model.model_fields) & set(written), f"{where}: a field of {model.__name__} also in the YAML"
+        generated = section_fields(model, None if where == section else where)     # a KEY field is written there
+        assert not set(generated) & set(written), f"{where}: a field of {model.__name__} also in the YAML"
     for name, field in model.model_fields.items():
         extra = field.json_schema_extra or {}
         node = section_schema(schema, extra.get(SECTION, section))
         if extra.get(KEY):       # e.g. the emulator's seed, study.seed: a key of the schema, not of this section
-            assert name not in section_fields(model) and name not in node["properties"]
-            assert "default" in _schema_node(schema, extra[KEY])
+            assert name not in section_fields(model)
+            assert (name in node["properties"]) == (extra[KEY] == f"{section}.{name}")   # a key of its own section
+            assert ("default" in _schema_node(schema, extra[KEY])) != field.is_required()
             continue
         key = node["properties"][name]
         assert key["description"] == field.description and field.description
         assert key.get("x-rule") == extra.get("x-rule")
         assert key.get("x-unit") == extra.get("x-unit")
-        if name in node.get("required", []):
+        if name in node.get("required", []) or extra.get(OPTIONAL):     # required, or left out: not given
             assert "default" not in key
         else:
             assert key["default"] == field.default

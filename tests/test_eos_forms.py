@@ -167,7 +167,7 @@ def test_library_door_refuses_with_the_config_words():
     with pytest.raises(InputError, match=r"^material\.T_melt_K: missing$"):
         material_properties({"rho0_g_cc": 8.93, "eos": {"c0_km_s": 3.94, "s": 1.5, "gamma0": 2.0}, "T_ref_K": 298.0,
                              "cv_J_per_kg_K": 383.0})
-    with pytest.raises(InputError, match=r"^MaterialProperties: T_melt_K \(250 K\) is not above"):
+    with pytest.raises(InputError, match=r"^material\.T_melt_K: T_melt_K \(250 K\) is not above"):
         load_material("copper", T_melt_K=250.0)
 
 

@@ -136,8 +136,11 @@ def test_the_library_refuses_what_the_config_refuses():
     from shockcal.simulators.outputs import OutputSpec
 
     with pytest.raises(InputError, match=r"OutputSpec\.velocity_column: missing; a trace output names its velocity"):
-        OutputSpec("trace", "trace.csv", velocity_column="")
-    with pytest.raises(InputError, match=r"OutputSpec\.velocity_unit: 'm/us' is not one of"):
-        OutputSpec("trace", "trace.csv", velocity_unit="m/us")
+        OutputSpec(kind="trace", file="trace.csv", time_column="t")
+    with pytest.raises(InputError, match=r"OutputSpec\.velocity_column '': String should have at least 1 character"):
+        OutputSpec(kind="trace", file="trace.csv", time_column="t", velocity_column="")
+    with pytest.raises(InputError, match=r"OutputSpec\.velocity_unit 'm/us': Input should be 'cm/us', 'm/s'"):
+        OutputSpec(kind="trace", file="trace.csv", time_column="t", velocity_column="v", velocity_unit="m/us")
     with pytest.raises(InputError, match=r"CommandSettings\.timeout_s: 0 is not a positive number"):
-        CommandSettings(("deck.txt",), "run", OutputSpec("features", "features.csv"), timeout_s=0)
+        CommandSettings(templates=["deck.txt"], command="run", output=OutputSpec(kind="features", file="features.csv"),
+                        timeout_s=0)

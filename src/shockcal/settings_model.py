@@ -24,6 +24,7 @@ from shockcal.errors import InputError, shown
 
 KEY = "x-key"            # a field the config gives by a key of its own (e.g. `study.seed`), not generated
 SECTION = "x-section"    # a field that is a key of another config section than the model's own (generated there)
+OPTIONAL = "x-optional"  # a field the config may leave out (None: not given), with no default and no null
 TYPES = {float: "number", int: "integer", bool: "boolean", str: "string", int | float: "number"}
 LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exclusiveMinimum"),
           (annotated_types.Le, "le", "maximum"), (annotated_types.Lt, "lt", "exclusiveMaximum"),
@@ -31,13 +32,16 @@ LIMITS = ((annotated_types.Ge, "ge", "minimum"), (annotated_types.Gt, "gt", "exc
 
 
 def setting(default, description: str, unit: str | None = None, key: str | None = None, section: str | None = None,
-            extra: dict | None = None, **limits):
-    """A settings field: its `default`, its `description` (the config page's text), its unit when its name
-    does not say it, the config `key` that gives it when no section of the model's holds it (e.g.
+            extra: dict | None = None, optional: bool = False, **limits):
+    """A settings field: its `default` (`...`: required), its `description` (the config page's text), its unit
+    when its name does not say it, the config `key` that gives it when no section of the model's holds it (e.g.
     `study.seed`: not generated), the config `section` it is a key of when that is not the model's own
     (dotted, `*` for every key of a mapping: `shots.*.analysis`; generated there), further schema keywords
-    `extra` (`x-...`), and its `limits` (pydantic's ge, gt, le, lt; a list's min_length, max_length)."""
-    schema = {name: value for name, value in (("x-unit", unit), (KEY, key), (SECTION, section)) if value is not None}
+    `extra` (`x-...`), whether it is `optional` (default None: the config leaves it out to say "not given"; its
+    schema entry has no default and no null) and its `limits` (pydantic's ge, gt, le, lt; a list's min_length,
+    max_length)."""
+    schema = {name: value for name, value in (("x-unit", unit), (KEY, key), (SECTION, section),
+                                              (OPTIONAL, optional or None)) if value is not None}
     return Field(default, description=description, json_schema_extra=(schema | (extra or {})) or None, **limits)
 
 
@@ -66,7 +70,7 @@ class SettingsModel(BaseModel):
             value = "" if error["type"] == "missing" else f" {_shown(error['input'])}"
             close = difflib.get_close_matches(str(where), list(type(self).model_fields), n=1)
             hint = f"; did you mean '{close[0]}'?" if error["type"] == "extra_forbidden" and close else ""
-            reason = f"{error['msg']}{hint}"
+            reason = "missing" if error["type"] == "missing" else f"{error['msg']}{hint}"     # the config's word
             raise SettingsError(f"{type(self).__name__}.{where}{value}: {reason}", str(where), reason) from None
 
     @field_validator("*", mode="before")
@@ -74,7 +78,7 @@ class SettingsModel(BaseModel):
     def _config_types(cls, value, info):
         """The config's types (JSON Schema's): a flag is true or false, a number is no text and no flag (pydantic
         alone would read "2" as 2, "yes" as true and true as 1, which the config refuses)."""
-        annotation = cls.model_fields[info.field_name].annotation
+        annotation = _without_none(cls.model_fields[info.field_name].annotation)
         if annotation is bool and not isinstance(value, bool):
             raise PydanticCustomError("config_type", "not true or false")
         if annotation in (int, float, int | float) and isinstance(value, bool | str):
@@ -90,6 +94,14 @@ class SettingsModel(BaseModel):
     def replace(self, **changes):
         """A copy with `changes` (field names and values), checked like a new one (pydantic's model_copy is not)."""
         return type(self)(**{**self.model_dump(), **changes})
+
+
+def _without_none(annotation):
+    """A value-or-null type's value type (`float | None`: float); any other type as it is."""
+    if get_origin(annotation) is UnionType and type(None) in get_args(annotation):
+        members = [member for member in get_args(annotation) if member is not type(None)]
+        return members[0] if len(members) == 1 else annotation
+    return annotation
 
 
 def _shown(value) -> str:
@@ -117,13 +129,15 @@ def schema_properties(model: type[SettingsModel], required: list[str] = (), sect
                       ) -> dict[str, dict]:
     """The config schema's `properties` of `model`'s fields in config `section` (None: its own), in the
     schema's own words (`type` or `enum`, the limits, the `x-` keywords but x-section, `default`,
-    `description`); a key the config section `required` gets no default."""
+    `description`); a key the config section `required` gets no default, nor an optional field (`setting`'s
+    `optional`: left out, it is not given)."""
     properties = {}
     for name in section_fields(model, section):
-        field = model.model_fields[name]
-        entry = _value_schema(field.annotation, field.metadata)
-        entry |= {keyword: value for keyword, value in schema_extras(model)[name].items() if keyword != SECTION}
-        if name not in required:
+        field, extras = model.model_fields[name], schema_extras(model)[name]
+        entry = _value_schema(_without_none(field.annotation) if extras.get(OPTIONAL) else field.annotation,
+                              field.metadata)
+        entry |= {keyword: value for keyword, value in extras.items() if keyword not in (SECTION, OPTIONAL)}
+        if name not in required and not extras.get(OPTIONAL):
             entry["default"] = field.default
         entry["description"] = field.description
         properties[name] = entry
@@ -151,4 +165,6 @@ def _value_schema(annotation, metadata=()) -> dict:
         entry = {"type": TYPES[annotation]}
     for limit in metadata:
         entry |= {keyword: getattr(limit, attr) for kind, attr, keyword in LIMITS if isinstance(limit, kind)}
+    if entry.get("type") == "string":        # a text's length limits: JSON Schema's words for a text
+        entry |= {f"{end}Length": entry.pop(f"{end}Items") for end in ("min", "max") if f"{end}Items" in entry}
     return entry

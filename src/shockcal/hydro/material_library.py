@@ -20,7 +20,6 @@ from __future__ import annotations
 import copy
 import functools
 from collections.abc import Mapping
-from dataclasses import MISSING, fields
 from pathlib import Path
 
 import yaml
@@ -28,6 +27,7 @@ import yaml
 from shockcal.errors import InputError
 from shockcal.hydro.hugoniot import CUBIC_KEYS, HUGONIOT_KEYS, cubic_eos
 from shockcal.hydro.settings import MaterialProperties
+from shockcal.settings_model import SettingsError
 
 LIBRARY_DIR = Path(__file__).parents[1] / "materials"
 
@@ -98,20 +98,10 @@ def material_properties(section: Mapping, where: str = "material") -> MaterialPr
         raise InputError(f"{where}.eos: missing; give the cubic ({', '.join(CUBIC_KEYS)}) or the Us-up Hugoniot "
                          f"({', '.join(HUGONIOT_KEYS)}), each with gamma0")
     flat = {**{k: v for k, v in resolved.items() if k not in ("name", "eos")}, **eos}
-    names = [f.name for f in fields(MaterialProperties)]
-    unknown = sorted(set(flat) - set(names))
-    if unknown:
-        raise InputError(f"{where}.{unknown[0]}: not a material key (known: {', '.join(names)})")
-    missing = [f.name for f in fields(MaterialProperties) if f.name not in flat and f.default is MISSING]
-    if missing:
-        raise InputError(f"{where}.{missing[0]}: missing")
-    return MaterialProperties(**{k: _number(v) for k, v in flat.items()})
-
-
-def _number(value):
-    """`value` as a float when it is a number (YAML's 1350 is an int), else as given, for
-    MaterialProperties' own check to name."""
-    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else value
+    try:
+        return MaterialProperties(**flat)
+    except SettingsError as error:
+        raise InputError(f"{where}.{error.field}: {error.reason}") from None
 
 
 def load_material(name: str, **overrides) -> MaterialProperties:

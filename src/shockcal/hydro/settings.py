@@ -10,12 +10,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from pydantic import model_validator
+
 from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
 from shockcal.hydro.rules import check_fields, melting_problem, plate_problem
 from shockcal.hydro.settings_model import SettingsModel, setting
 from shockcal.hydro.state import InitialState, Material, Numerics
+from shockcal.settings_model import SettingsError, section_fields
 from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, PER_S_TO_PER_US, UM_TO_CM
+
+EOS = "material.eos"      # the config section of the equation of state's coefficients (MaterialProperties)
 
 
 @dataclass(frozen=True)
@@ -50,51 +55,64 @@ class Geometry:
             raise InputError("Geometry.stop_after_rise_us and Geometry.rise_fraction: give both or neither")
 
 
-@dataclass(frozen=True)
-class MaterialProperties:
-    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target;
-    checked on creation (`shockcal.hydro.rules`: an InputError naming the field). From a library name or
-    the Us-up Hugoniot (c0, s, gamma0): `shockcal.hydro.material_library.load_material("copper")`,
-    `shockcal.hydro.material_library.material_properties(section)` (the study config's `material` rules).
-
-    Args:
-        rho0_g_cc: initial density (g/cc).
-        c1_Mbar, c2_Mbar, c3_Mbar: cold-curve coefficients P = c1 mu + c2 mu^2 + c3 mu^3 (Mbar).
-        gamma0: Grueneisen parameter (-); gamma0 rho0 is held constant.
-        T_ref_K: reference (room) temperature (K), where T* = 0.
-        T_melt_K: melting temperature (K), where T* = 1 and the strength vanishes.
-        cv_J_per_kg_K: specific heat (J/kg/K).
-        strain_rate_ref_per_s: the Johnson-Cook reference strain rate eps0 (1/s).
-        molar_mass_g_per_mol: molar mass (g/mol; an alloy's mean atomic mass), which PTW's strain-rate
-            scale reads; None: not given (a law that needs it is refused, naming it).
-        melt_T_m0_K, melt_gamma0, melt_a: Steinberg's melt law T_m = T_m0 exp(2a(1 - 1/eta))
-            eta^(2(gamma0 - a - 1/3)) (Steinberg-Guinan's): melt temperature at eta = 1 (K), its Grueneisen
-            coefficient and first-order volume coefficient (-); None: not given.
+class MaterialProperties(SettingsModel):
+    """Mie-Grueneisen EOS (cubic cold curve in mu = rho/rho0 - 1) and thermal constants of flyer and target: the
+    study config's `material` section once resolved (its library entry filled in, its EOS as the cubic:
+    `shockcal.hydro.material_library.material_properties(section)`, `load_material("copper")`). Each field's
+    rule, default and description is here once; the config schema's `material` and `material.eos` entries are
+    generated from them. Checked on creation: an InputError naming the field. A field left None is not given (a
+    law that needs it is refused, naming it).
     """
 
-    rho0_g_cc: float
-    c1_Mbar: float
-    c2_Mbar: float
-    c3_Mbar: float
-    gamma0: float
-    T_ref_K: float
-    T_melt_K: float
-    cv_J_per_kg_K: float
-    strain_rate_ref_per_s: float = 1.0
-    molar_mass_g_per_mol: float | None = None
-    melt_T_m0_K: float | None = None
-    melt_gamma0: float | None = None
-    melt_a: float | None = None
+    rho0_g_cc: float = setting(..., "Initial density.", "positive")
+    c1_Mbar: float = setting(
+        ..., "Cubic form: linear coefficient c1 (the bulk modulus; the bulk sound speed is sqrt(c1 / rho0)); "
+             "c1_Mbar, c2_Mbar, c3_Mbar are required unless c0_km_s and s are given.", "positive", section=EOS)
+    c2_Mbar: float = setting(..., "Cubic form: quadratic coefficient c2.", "finite", section=EOS)
+    c3_Mbar: float = setting(..., "Cubic form: cubic coefficient c3.", "finite", section=EOS)
+    gamma0: float = setting(..., "Grueneisen coefficient gamma0 (dimensionless); in both forms.", "nonnegative",
+                            section=EOS)
+    T_ref_K: float = setting(..., "Reference (room) temperature, where Johnson-Cook thermal softening starts "
+                                  "(T* = 0).", "positive")
+    T_melt_K: float = setting(..., "Melting temperature, where the flow stress vanishes (T* = 1); above T_ref_K.",
+                              "positive")
+    cv_J_per_kg_K: float = setting(..., "Specific heat at constant volume (temperature from internal energy).",
+                                   "positive")
+    strain_rate_ref_per_s: float = setting(
+        1.0, "Johnson-Cook reference strain rate epsdot_0: the rate factor is 1 + C ln(epsdot / epsdot_0), "
+             "floored at 1.", "positive")
+    molar_mass_g_per_mol: float | None = setting(
+        None, "Molar mass (an alloy's mean atomic mass), PTW's M in its strain-rate scale. Left out (and not in the "
+              "library entry): a ptw study stops naming this key. Only a study whose law reads it slices it into "
+              "its simulate (and yield-input emulate) jobs (shockcal.study.stages), so it reruns no other law's.",
+        "positive", optional=True)
+    melt_T_m0_K: float | None = setting(
+        None, "Steinberg's melt law T_m = T_m0 exp(2a (1 - 1/eta)) eta^(2 (gamma0 - a - 1/3)), Steinberg-Guinan's "
+              "melting temperature: T_m0, at eta = rho/rho0 = 1. Left out (and not in the library entry): a "
+              "steinberg-guinan study stops naming this key. Like melt_gamma0 and melt_a, sliced into the "
+              "simulate jobs of a steinberg-guinan study only (shockcal.study.stages).", "positive", optional=True)
+    melt_gamma0: float | None = setting(
+        None, "Steinberg's melt law: its Grueneisen coefficient gamma0 (dimensionless; Steinberg's table value, not "
+              "necessarily eos.gamma0). Left out: a steinberg-guinan study stops naming this key.", "nonnegative",
+        optional=True)
+    melt_a: float | None = setting(
+        None, "Steinberg's melt law: its first-order volume coefficient a (dimensionless). Left out: a "
+              "steinberg-guinan study stops naming this key.", "finite", optional=True)
 
-    def __post_init__(self):
-        check_fields(self, {"rho0_g_cc": "positive", "c1_Mbar": "positive", "c2_Mbar": "finite", "c3_Mbar": "finite",
-                            "gamma0": "nonnegative", "T_ref_K": "positive", "T_melt_K": "positive",
-                            "cv_J_per_kg_K": "positive", "strain_rate_ref_per_s": "positive",
-                            "molar_mass_g_per_mol": "positive", "melt_T_m0_K": "positive",
-                            "melt_gamma0": "nonnegative", "melt_a": "finite"})
+    @model_validator(mode="after")
+    def _melting_above_reference(self):
         problem = melting_problem(self.T_ref_K, self.T_melt_K)
         if problem:
-            raise InputError(f"MaterialProperties: {problem}")
+            raise SettingsError(f"MaterialProperties.T_melt_K: {problem}", "T_melt_K", problem)
+        return self
+
+    @classmethod
+    def from_section(cls, values: dict, **more):
+        """From a resolved `material` section (`shockcal.hydro.material_library.resolve_material`): its own keys
+        and its `eos` mapping's."""
+        eos = values.get("eos") if isinstance(values.get("eos"), dict) else {}
+        return super().from_section(values, **{name: eos[name] for name in section_fields(cls, EOS) if name in eos},
+                                    **more)
 
     def code_units(self) -> Material:
         return Material(self.rho0_g_cc, self.c1_Mbar, self.c2_Mbar, self.c3_Mbar, self.gamma0, self.T_ref_K,

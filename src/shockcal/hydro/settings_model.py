@@ -7,18 +7,22 @@ from __future__ import annotations
 
 from pydantic import model_validator
 
-from shockcal.hydro.rules import check_fields
+from shockcal.hydro.rules import problem
+from shockcal.settings_model import SettingsError, schema_extras
 from shockcal.settings_model import SettingsModel as BaseSettingsModel
-from shockcal.settings_model import schema_extras
 from shockcal.settings_model import setting as base_setting
 
 RULE = "x-rule"
 
 
-def setting(default, description: str, rule: str | None = None, unit: str | None = None):
-    """A settings field: its `default`, its `description` (the config page's text), the name of its rule in
-    `shockcal.hydro.rules.RULES` (None: any value of its type) and its unit when its name does not say it."""
-    return base_setting(default, description, unit, extra={RULE: rule} if rule is not None else None)
+def setting(default, description: str, rule: str | None = None, unit: str | None = None, section: str | None = None,
+            optional: bool = False):
+    """A settings field: its `default` (`...`: required), its `description` (the config page's text), the name of
+    its rule in `shockcal.hydro.rules.RULES` (None: any value of its type), its unit when its name does not say
+    it, the config `section` it is a key of when that is not the model's own and whether the config may leave it
+    out to say "not given" (`optional`, default None; `shockcal.settings_model.setting`)."""
+    return base_setting(default, description, unit, section=section, optional=optional,
+                        extra={RULE: rule} if rule is not None else None)
 
 
 class SettingsModel(BaseSettingsModel):
@@ -26,5 +30,10 @@ class SettingsModel(BaseSettingsModel):
 
     @model_validator(mode="after")
     def _check_rules(self):
-        check_fields(self, {name: extra[RULE] for name, extra in schema_extras(type(self)).items() if RULE in extra})
+        """The first field (not None) that breaks its rule: a SettingsError naming the class and the field."""
+        for name, extra in schema_extras(type(self)).items():
+            value = getattr(self, name)
+            found = problem(value, extra[RULE]) if RULE in extra and value is not None else None
+            if found:
+                raise SettingsError(f"{type(self).__name__}.{name}: {found}", name, found)
         return self

@@ -27,19 +27,20 @@ import shutil
 import signal
 import subprocess
 import time
-from collections.abc import Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
+from pydantic import Field
 
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
-from shockcal.hydro.rules import check_fields
+from shockcal.hydro.settings_model import SettingsModel, setting
 from shockcal.io import atomic_path
 from shockcal.progress import progress
+from shockcal.settings_model import setting as base_setting
 from shockcal.simulators.builtin import DIAGNOSTICS, simulation_columns
 from shockcal.simulators.outputs import OutputError, OutputSpec, read_output
 from shockcal.simulators.templates import command_values, render, run_values
@@ -51,30 +52,23 @@ KILL_GRACE_S = 2.0            # SIGTERM to the process group, then SIGKILL this 
 STDERR_TAIL_CHARS = 300       # the end of stderr quoted in a failed run's reason
 
 
-@dataclass(frozen=True)
-class CommandSettings:
-    """An external code (the config's `simulator.command`).
+class CommandSettings(SettingsModel):
+    """An external code (the config's `simulator.command`): each field's rule, default and description once, the
+    schema's entries generated from them; checked on creation, a SettingsError naming the field."""
 
-    Args:
-        templates: input template files, each rendered into the run's folder under its own name.
-        command: the command line, run through /bin/sh in the run's folder (placeholders allowed).
-        output: what the run writes (`OutputSpec`).
-        timeout_s: wall time (s) after which the run's process group is killed and the attempt failed.
-        retries: further attempts after a failed one.
-        env: environment variables added to shockcal's for the command.
-    """
-
-    templates: tuple[str, ...]
-    command: str
-    output: OutputSpec
-    timeout_s: float
-    retries: int = 0
-    env: Mapping[str, str] = field(default_factory=dict)
-
-    def __post_init__(self):
-        check_fields(self, {"timeout_s": "positive", "retries": "nonnegative"})
-        if not self.templates:
-            raise InputError("CommandSettings.templates: no template files; give at least one")
+    templates: list[str] = base_setting(
+        ..., "Input template files (relative to the working directory), each rendered into the run's folder under "
+             "its own name; placeholders such as {A_MPa}, {velocity_m_s}, {flyer_mm} name their unit "
+             "(docs/simulators.md lists them; an unknown one is refused).", min_length=1)
+    command: str = base_setting(
+        ..., "The command line, run through /bin/sh in the run's folder; the templates' placeholders and {python}, "
+             "{study_dir}, {run_dir} are replaced.", min_length=1)
+    output: OutputSpec = base_setting(..., "What one run writes in its folder.", key="simulator.command.output")
+    timeout_s: float = setting(..., "Wall time (s) of one attempt; past it the attempt's whole process group is "
+                                    "killed and the attempt failed.", "positive")
+    retries: int = base_setting(0, "Further attempts of a failed run (the same folder, inputs rendered again).", ge=0)
+    env: dict[str, Annotated[str, Field(description="The variable's value.")]] = base_setting(
+        {}, "Environment variables set for the command, on top of shockcal's own.")
 
 
 def simulate_design_command(design: pd.DataFrame, mapping: ShotMapping, geometry: Geometry,

@@ -9,15 +9,16 @@ units its spec declares and converted to us and m/s; a features row is in us and
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pandas as pd
+from pydantic import model_validator
 
-from shockcal.errors import InputError
 from shockcal.io import text_encoding
 from shockcal.plausibility import OTHER_UNITS, PLATEAU_RATIO, feature_problems
+from shockcal.settings_model import SettingsError, SettingsModel, setting
 from shockcal.units import VELOCITY_TO_M_S
 from shockcal.velocimetry.columns import COLUMNS
 
@@ -29,28 +30,28 @@ class OutputError(Exception):
     """A run's output is unusable; the message is the failed run's reason."""
 
 
-@dataclass(frozen=True)
-class OutputSpec:
-    """What an external run writes in its folder.
+class OutputSpec(SettingsModel):
+    """What an external run writes in its folder (the config's `simulator.command.output`, and an archive's
+    `simulator.archive.trace`): each field's default and description once, the schema's `run_output` generated
+    from them. Checked on creation by `output_problem`, the config's rule too: a SettingsError naming the field."""
 
-    Args:
-        kind: "trace" (time and velocity columns) or "features" (one row of the ten features, us and m/s).
-        file: the file's name, relative to the run's folder.
-        time_column, velocity_column: a trace's column names (header line; `#` lines are comments).
-        time_unit: us, ns, ms or s. velocity_unit: m/s, cm/us, km/s or mm/us.
-    """
+    kind: Literal["trace", "features"] = setting(
+        "trace", "trace (time and velocity columns) or features (one row of the ten features, us and m/s).")
+    file: str = setting("trace.csv", "The output file's name in the run's folder (CSV; `#` lines are comments).")
+    time_column: str | None = setting(None, "A trace's time column (its header name); required for a trace.",
+                                      optional=True, min_length=1)
+    time_unit: Literal[tuple(TIME_TO_US)] = setting("us", "Unit of the time column.")
+    velocity_column: str | None = setting(
+        None, "A trace's free-surface velocity column (its header name); required for a trace.", optional=True,
+        min_length=1)
+    velocity_unit: Literal[tuple(VELOCITY_TO_M_S)] = setting("m/s", "Unit of the velocity column.")
 
-    kind: str = "trace"
-    file: str = "trace.csv"
-    time_column: str = "t_us"
-    time_unit: str = "us"
-    velocity_column: str = "v_m_s"
-    velocity_unit: str = "m/s"
-
-    def __post_init__(self):
-        found = output_problem(asdict(self))
+    @model_validator(mode="after")
+    def _trace_names_its_columns(self):
+        found = output_problem(self.model_dump())
         if found:
-            raise InputError(f"OutputSpec.{found[0]}: {found[1]}")
+            raise SettingsError(f"OutputSpec.{found[0]}: {found[1]}", *found)
+        return self
 
 
 def output_problem(spec: Mapping) -> tuple[str, str] | None:

@@ -21,7 +21,6 @@ from __future__ import annotations
 import string
 import sys
 from collections.abc import Mapping
-from dataclasses import asdict, fields
 from pathlib import Path
 
 from shockcal.design.tables import ShotMapping
@@ -50,7 +49,7 @@ def placeholder_units(mapping: ShotMapping) -> dict[str, str]:
         names.update({name: _unit(name) for name in mapping.strength_inputs})
     if mapping.shear_modulus_inputs:
         names.update(_MODULUS)
-    names.update({f.name: _unit(f.name) for f in fields(MaterialProperties)})
+    names.update({name: _unit(name) for name in MaterialProperties.model_fields})
     names.update({name: _unit(name) for name in HydroSettings.model_fields})
     return names
 
@@ -63,7 +62,7 @@ def run_values(mapping: ShotMapping, row: Mapping, geometry: Geometry, material:
               "flyer_mm": geometry.flyer_mm, "target_mm": geometry.target_mm, "end_time_us": geometry.end_us,
               "initial_temperature_K": (material.T_ref_K if geometry.initial_temperature_K is None
                                         else geometry.initial_temperature_K),
-              **asdict(material), **settings.model_dump()}
+              **material.model_dump(), **settings.model_dump()}
     values["velocity_cm_us"] = float(row[mapping.velocity_input])
     if mapping.model == "johnson-cook":
         exact = params.table_iv()

@@ -345,8 +345,7 @@ def command_settings(config: dict):
     from shockcal.simulators.outputs import OutputSpec
 
     section = config["simulator"]["command"]
-    return CommandSettings(tuple(section["templates"]), section["command"], OutputSpec(**section["output"]),
-                           float(section["timeout_s"]), int(section["retries"]), dict(section["env"]))
+    return CommandSettings.from_section(section, output=OutputSpec(**section["output"]))
 
 
 def archive_source(config: dict, shot: str):

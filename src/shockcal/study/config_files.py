@@ -31,7 +31,7 @@ from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettin
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws.settings import StrengthSettings
-from shockcal.hydro.settings import HydroSettings
+from shockcal.hydro.settings import HydroSettings, MaterialProperties
 from shockcal.inference.settings import (
     CheckSettings,
     DiscrepancySettings,
@@ -43,6 +43,8 @@ from shockcal.inference.settings import (
 from shockcal.plausibility import ChecksSettings
 from shockcal.plots.settings import FigureSettings
 from shockcal.settings_model import other_sections, schema_properties
+from shockcal.simulators.command import CommandSettings
+from shockcal.simulators.outputs import OutputSpec
 from shockcal.simulators.settings import SimulateSettings
 from shockcal.velocimetry.settings import ExtractorSettings, ObservedSettings
 
@@ -56,15 +58,16 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest. A
 # field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there. A
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
-MODEL_SECTIONS = {"hydro": HydroSettings, "emulator": EmulatorSettings, "features": ExtractorSettings,
-                  "calibration": SamplerSettings, "calibration.check": CheckSettings,
+MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "emulator": EmulatorSettings,
+                  "features": ExtractorSettings, "calibration": SamplerSettings, "calibration.check": CheckSettings,
                   "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings, "design": DesignSettings,
                   "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
                   "design.waves.step_calibration": StepSamplerSettings, "checks": ChecksSettings,
                   "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
                   "figures": FigureSettings, "next_shot": NextShotSettings,
-                  "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings, "next_shot.check": NextShotCheckSettings,
-                  "observed": ObservedSettings, "strength": StrengthSettings}
+                  "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings,
+                  "next_shot.check": NextShotCheckSettings, "observed": ObservedSettings, "strength": StrengthSettings,
+                  "simulator.command": CommandSettings, "definitions.run_output": OutputSpec}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
@@ -80,10 +83,13 @@ def _schema_text_parsed() -> dict:
 
 
 def section_schema(schema: dict, section: str) -> dict:
-    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`); of
+    """The schema entry of config `section` (dotted; `*`: every key of a mapping, e.g. `shots.*.analysis`;
+    `definitions.<name>`: a shared entry); of
     a key that is a mapping or something else (`oneOf`), its mapping form's."""
-    entry = schema
-    for part in section.split("."):
+    entry, parts = schema, section.split(".")
+    if parts[0] == "definitions":     # a shared entry (`definitions.run_output`), which sections `$ref`
+        entry, parts = schema["definitions"][parts[1]], parts[2:]
+    for part in parts:
         entry = entry["additionalProperties"] if part == "*" else entry["properties"][part]
     return next((option for option in entry["oneOf"] if option.get("type") == "object"), entry) if "oneOf" in entry \
         else entry

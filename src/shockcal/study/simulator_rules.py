@@ -45,12 +45,14 @@ def check_command(config: dict, source: str) -> None:
 
 
 def check_output(output: dict, where: str) -> None:
-    """The output spec's rules (`shockcal.simulators.outputs.output_problem`, the library's own)."""
-    from shockcal.simulators.outputs import output_problem
+    """The output spec through the library's own model (`shockcal.simulators.outputs.OutputSpec`)."""
+    from shockcal.settings_model import SettingsError
+    from shockcal.simulators.outputs import OutputSpec
 
-    found = output_problem(output)
-    if found:
-        raise ConfigError(f"{where}.{found[0]}: {found[1]}")
+    try:
+        OutputSpec(**output)
+    except SettingsError as exc:
+        raise ConfigError(f"{where}.{exc.field}: {exc.reason}") from None
 
 
 def check_archive(config: dict, source: str) -> None:
