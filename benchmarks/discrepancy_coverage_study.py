@@ -1,7 +1,9 @@
 """Known-discrepancy and null coverage on a study's emulator (issue 63), with and without `calibration.discrepancy`.
 
-Truths: rows of the study's joint posterior draws (`--truths-from`, native units). Records: the emulator's mean
-at the truth, plus a discrepancy, plus 1% noise (lambda_y = 1). The discrepancy (`--records`):
+Truths: rows of the study's joint posterior draws (`--truths-from`, native units). Records: the truth's features
+(`--eta`: `hydrocode`, the study's hydrocode and extractor at the truth, so the records carry the emulator's own
+error as real ones do; `emulator`, its mean, which leaves that error out), plus a discrepancy, plus 1% noise
+(lambda_y = 1); a truth whose run fails is reported and skipped. The discrepancy (`--records`):
 - `prior`: drawn from the feature-kind term's prior (`shockcal.inference.discrepancy`, `--sd-fraction-prior`);
 - `shift`: out of family, a per-shot timing error of the plastic rise: each shot's slope features (v_slope1,
   v_slope2, read at two times on the rise) move by the record's rise rate (v_slope2 - v_slope1) / (t_slope2 -
@@ -16,7 +18,7 @@ Student-t block is refused by the discrepancy): pass an emulator fitted with `em
 
     nice -n 10 .venv/bin/python benchmarks/discrepancy_coverage_study.py --config results/config.yaml \\
         --emulator results/emulator --truths-from results/posterior/joint.parquet \\
-        --observed results/features/observed.parquet --records none --truths 30 --n-live 250 --n-eff 500
+        --observed results/features/observed.parquet --records none --eta hydrocode --truths 30 --n-live 250 --n-eff 500
 """
 
 import argparse
@@ -29,9 +31,12 @@ from shockcal.emulator.study_emulator import Emulator
 from shockcal.inference.calibration import calibrate
 from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, Discrepancy
 from shockcal.io import read_table
-from shockcal.study.adapters import calibration_settings
+from shockcal.simulators.builtin import simulate_design
+from shockcal.study.adapters import calibration_settings, extractor_settings, hydro_inputs, shot_mapping
 from shockcal.study.config import prior_bounds
 from shockcal.study.stages import load_stage_config
+from shockcal.study.validate import load_config
+from shockcal.velocimetry.feature_tables import features_table
 
 SLOPES = ("v_slope1", "v_slope2")
 
@@ -41,6 +46,22 @@ def shift_sd_m_s(observed: pd.DataFrame, shots, shift_ns: float) -> np.ndarray:
     rows = observed.set_index("shot").loc[list(shots)]
     rate = (rows["v_slope2"] - rows["v_slope1"]) / (rows["t_slope2"] - rows["t_slope1"])      # m/s per us
     return (rate * shift_ns * rows["readout_half_window_ns"] * 1e-3).to_numpy(float)
+
+
+def hydrocode_features(config: dict, theta, shots, features) -> np.ndarray | None:
+    """The study's hydrocode and extractor at `theta` (native units), the calibration features shot by shot
+    (F,); None (and a line saying why) when a run fails."""
+    values = []
+    for shot in shots:
+        mapping = shot_mapping(config, shot)
+        row = pd.DataFrame([{"run": 0, **{name: float(theta[name]) for name in mapping.inputs()}}])
+        traces = simulate_design(row, mapping, *hydro_inputs(config, config["shots"][shot]))
+        table = features_table(traces, extractor_settings(config, shot))
+        if table.status.iloc[0] != "ok":
+            print(f"  truth skipped: {shot}'s run failed: {table.reason.iloc[0]}", flush=True)
+            return None
+        values.extend(float(table[name].iloc[0]) for name in features)
+    return np.array(values)
 
 
 def records(args, eta, features, shots, disc, shift_sd, rng):
@@ -78,9 +99,14 @@ def run(args):
     rows, cost = [], {k: 0.0 for k in runs}
     if args.records == "shift":
         print("shift: the slope features' sd per shot (m/s):", {s: round(float(v), 2) for s, v in zip(shots, shift_sd)})
+    full = load_config(args.config) if args.eta == "hydrocode" else None
     for trial in range(args.truths):
         theta = truths.iloc[int(rng.integers(len(truths)))]
         eta = emulator.predict({n: np.array([theta[n]]) for n in names}, shots)[0][0]
+        if full is not None:
+            eta = hydrocode_features(full, theta, shots, features)
+            if eta is None:
+                continue
         y, scale = records(args, eta, features, shots, disc, shift_sd, rng)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=features).assign(shot=shots)
         seed = int(rng.integers(2**31))
@@ -117,7 +143,7 @@ def report(table, args, cost, names):
     ratio = (both["width_box"]["feature_kind"] / both["width_box"]["none"]).groupby("parameter").agg(["mean", "max"])
     out = pivot.join(move.add_prefix("median_move_box_")).join(ratio.add_prefix("width_ratio_")).loc[names]
     n = table.trial.nunique()
-    print(f"\nrecords {args.records}, {n} truths, n_live {args.n_live}, n_eff {args.n_eff}, sd_fraction_prior "
+    print(f"\nrecords {args.records} on the {args.eta}'s features, {n} truths, n_live {args.n_live}, n_eff {args.n_eff}, sd_fraction_prior "
           f"{args.sd_fraction_prior}; 90% coverage (none / feature_kind), |median with - without| in box units and the "
           "90% width ratio with / without (mean, max over truths):")
     print(out.to_string(float_format=lambda v: f"{v:.3f}"))
@@ -137,6 +163,8 @@ if __name__ == "__main__":
     parser.add_argument("--truths-from", required=True, help="the joint posterior's draws (Parquet, native units)")
     parser.add_argument("--observed", required=True, help="the measured features table (rise times, read-out)")
     parser.add_argument("--records", choices=["prior", "shift", "none"], default="prior")
+    parser.add_argument("--eta", choices=["hydrocode", "emulator"], default="hydrocode",
+                        help="the truth's features: the hydrocode's run, or the emulator's mean")
     parser.add_argument("--truths", type=int, default=30)
     parser.add_argument("--sd-fraction-prior", type=float, default=0.02)
     parser.add_argument("--shift-ns", type=float, default=1.0, help="timing sd in read-out half-windows")

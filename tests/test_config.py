@@ -209,6 +209,11 @@ def test_library_settings_defaults_are_the_configs(target, sections, renamed, wh
     drift = {field: (library[field], default) for field, default in config_defaults.items()
              if field in library and library[field] != default}
     assert not drift, f"{name}: library default != config default: {drift}"
+    required = {field for field, path in keys.items()
+                if field in _section_node(schema, path.rsplit(".", 1)[0]).get("required", [])}
+    unsaid = {field: library[field] for field in set(keys) - set(config_defaults) - required
+              if library.get(field) is not None}      # the config leaves it out as "not given"
+    assert not unsaid, f"{name}: a library default the config does not have: {unsaid}"
     if whole:   # the sections' every default is one of the settings', and every field a config key
         section_defaults = {k for section in sections
                             for k, node in _section_node(schema, section)["properties"].items() if "default" in node}
