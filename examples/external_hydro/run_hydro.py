@@ -46,7 +46,7 @@ def simulate(deck: dict):
     params = ShotParameters.from_table_iv(deck["A_Mbar"], deck["B_Mbar"], deck["C"], deck["n"], deck["m"],
                                           deck["velocity_cm_us"], deck["shear_modulus_Mbar"])
     geometry = Geometry(deck["flyer_mm"], deck["target_mm"], deck["end_time_us"], deck["initial_temperature_K"])
-    material = MaterialProperties(**{k: deck[k] for k in MaterialProperties.__dataclass_fields__ if k in deck})
+    material = MaterialProperties(**{k: deck[k] for k in MaterialProperties.model_fields if k in deck})
     settings = HydroSettings(**{k: deck[k] for k in HydroSettings.model_fields})
     result = run_shot(params, geometry, material, settings)
     return result.t_us, result.v_m_s, result.status, result.reason
