@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from shockcal.emulator.study_emulator import Emulator
+from shockcal.errors import SamplerError
 from shockcal.inference.calibration import calibrate
 from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, Discrepancy
 from shockcal.io import read_table
@@ -100,22 +101,37 @@ def run(args):
     if args.records == "shift":
         print("shift: the slope features' sd per shot (m/s):", {s: round(float(v), 2) for s, v in zip(shots, shift_sd)})
     full = load_config(args.config) if args.eta == "hydrocode" else None
+    failed = []
     for trial in range(args.truths):
         theta = truths.iloc[int(rng.integers(len(truths)))]
         eta = emulator.predict({n: np.array([theta[n]]) for n in names}, shots)[0][0]
-        if full is not None:
+        if full is not None and trial >= args.skip:
             eta = hydrocode_features(full, theta, shots, features)
             if eta is None:
                 continue
         y, scale = records(args, eta, features, shots, disc, shift_sd, rng)
         observed = pd.DataFrame(y.reshape(len(shots), -1), columns=features).assign(shot=shots)
         seed = int(rng.integers(2**31))
+        if trial < args.skip:           # its draws taken, so the later truths are the same as in a full run
+            continue
+        done = []
         for kind, setting in runs.items():
             settings = base.replace(discrepancy=setting).with_sampler(n_live=args.n_live, n_eff=args.n_eff,
-                                                                        draws=args.n_eff, seed=seed)
+                                                                        draws=args.n_eff, seed=seed,
+                                                                        max_evaluations=args.max_evaluations)
             start = time.process_time()
-            posterior = calibrate(emulator, shots, observed, settings, f"trial {trial}")
-            cost[kind] += time.process_time() - start
+            try:
+                posterior = calibrate(emulator, shots, observed, settings, f"trial {trial}")
+            except SamplerError as exc:
+                failed.append((trial, kind, str(exc)))
+                print(f"  truth {trial + 1} left out: the {kind} calibration failed: {exc}", flush=True)
+                break
+            finally:
+                cost[kind] += time.process_time() - start
+            done.append((kind, posterior))
+        if len(done) < len(runs):
+            continue
+        for kind, posterior in done:
             summary = posterior.summary(native=True).set_index("parameter")
             for j, name in enumerate(names):
                 q05, q50, q95 = summary.loc[name, ["q05", "q50", "q95"]]
@@ -126,12 +142,15 @@ def run(args):
                 q05, q50, q95 = np.quantile(mean_fraction, [0.05, 0.5, 0.95])
                 rows.append({"trial": trial, "run": kind, "parameter": "scale", "truth": scale, "q50_box": q50,
                              "inside": q05 <= scale <= q95 if args.records == "prior" else None})
-        done = pd.DataFrame(rows)
-        done = done[done.parameter != "scale"]
+        table = pd.DataFrame(rows)
+        table = table[table.parameter != "scale"]
         print(f"truth {trial + 1}: 90% coverage over the inputs, none "
-              f"{done[done.run == 'none'].inside.mean():.2f}, feature_kind "
-              f"{done[done.run == 'feature_kind'].inside.mean():.2f}; CPU so far {cost}", flush=True)
+              f"{table[table.run == 'none'].inside.mean():.2f}, feature_kind "
+              f"{table[table.run == 'feature_kind'].inside.mean():.2f}; CPU so far {cost}", flush=True)
         report(pd.DataFrame(rows), args, cost, names)     # after every truth: a run stopped early keeps its table
+        if args.rows_out:
+            pd.DataFrame(rows).to_csv(args.rows_out, index=False)
+    print(f"{len(failed)} truths left out (a calibration failed): {failed}", flush=True)
 
 
 def report(table, args, cost, names):
@@ -171,4 +190,7 @@ if __name__ == "__main__":
     parser.add_argument("--n-live", type=int, default=250)
     parser.add_argument("--n-eff", type=int, default=500)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--skip", type=int, default=0, help="truths of a run stopped early: drawn, not calibrated")
+    parser.add_argument("--max-evaluations", type=int, default=150_000, help="the sampler's limit per calibration")
+    parser.add_argument("--rows-out", help="CSV of every truth's rows (to join runs)")
     run(parser.parse_args())
