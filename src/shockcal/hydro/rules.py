@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 from shockcal.errors import InputError, number
+from shockcal.settings_model import SettingsError
 
 # The fastest plate-impact launchers: two-stage light-gas guns fire flyers at up to about 8 km/s. Above
 # this the hydrocode's solid EOS (a cubic cold curve) and its strength laws are far outside their range;
@@ -95,12 +96,13 @@ def check(where: str, value, rule: str) -> None:
 
 
 def check_fields(owner, rules: dict[str, str]) -> None:
-    """Check a dataclass's fields by name (`rules`: field -> rule; a None value is skipped, the field's
-    'not given'), the first problem an InputError naming the class and the field."""
+    """Check an object's fields by name (`rules`: field -> rule; a None value is skipped, the field's
+    'not given'), the first problem a SettingsError (an InputError) naming the class and the field."""
     for name, rule in rules.items():
         value = getattr(owner, name)
-        if value is not None:
-            check(f"{type(owner).__name__}.{name}", value, rule)
+        found = problem(value, rule) if value is not None else None
+        if found:
+            raise SettingsError(f"{type(owner).__name__}.{name}: {found}", name, found)
 
 
 def melting_problem(T_ref_K: float, T_melt_K: float) -> str | None:

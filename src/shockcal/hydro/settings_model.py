@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from pydantic import model_validator
 
-from shockcal.hydro.rules import problem
-from shockcal.settings_model import SettingsError, schema_extras
+from shockcal.hydro.rules import check_fields
 from shockcal.settings_model import SettingsModel as BaseSettingsModel
+from shockcal.settings_model import schema_extras
 from shockcal.settings_model import setting as base_setting
 
 RULE = "x-rule"
@@ -31,9 +31,5 @@ class SettingsModel(BaseSettingsModel):
     @model_validator(mode="after")
     def _check_rules(self):
         """The first field (not None) that breaks its rule: a SettingsError naming the class and the field."""
-        for name, extra in schema_extras(type(self)).items():
-            value = getattr(self, name)
-            found = problem(value, extra[RULE]) if RULE in extra and value is not None else None
-            if found:
-                raise SettingsError(f"{type(self).__name__}.{name}: {found}", name, found)
+        check_fields(self, {name: extra[RULE] for name, extra in schema_extras(type(self)).items() if RULE in extra})
         return self

@@ -55,16 +55,10 @@ class OutputSpec(SettingsModel):
 
 
 def output_problem(spec: Mapping) -> tuple[str, str] | None:
-    """(key, what is wrong) with an output spec's fields, or None: its kind and units known, a trace's
-    columns named. The config's `simulator.command.output` is checked with the same words."""
-    kind = spec.get("kind", "trace")
-    if kind not in ("trace", "features"):
-        return "kind", f"{kind!r} is not trace or features"
-    for key, known in (("time_unit", TIME_TO_US), ("velocity_unit", VELOCITY_TO_M_S)):
-        if spec.get(key) is not None and spec[key] not in known:
-            return key, f"{spec[key]!r} is not one of {list(known)}"
+    """(key, what is wrong) with an output spec, or None: a trace names its columns (the kind and the units are
+    `OutputSpec`'s types)."""
     for column, unit, default in (("time_column", "time_unit", "us"), ("velocity_column", "velocity_unit", "m/s")):
-        if kind == "trace" and not spec.get(column):
+        if spec.get("kind", "trace") == "trace" and not spec.get(column):
             return column, (f"missing; a trace output names its {column.split('_')[0]} column (and its unit, {unit}: "
                             f"default {default})")
     return None

@@ -37,9 +37,9 @@ def _section_model(model, values: dict, section: str, source: str):
     command's `output`) built first, so a problem names the key it is in; a SettingsError as a ConfigError."""
     nested = {}
     for name, extra in schema_extras(model).items():
-        key = extra.get(KEY, "").removeprefix(f"{section}.")
-        if f"{section}.{key}" == extra.get(KEY) and isinstance(values.get(key), dict):      # simulator.command.output
-            nested[name] = _section_model(model.model_fields[name].annotation, values[key], f"{section}.{key}", source)
+        where = extra.get(KEY, "")                  # simulator.command.output: a key of this section
+        if where.startswith(f"{section}.") and isinstance(values.get(key := where.removeprefix(f"{section}.")), dict):
+            nested[name] = _section_model(model.model_fields[name].annotation, values[key], where, source)
     try:
         return model.from_section(values, **nested)
     except SettingsError as exc:

@@ -24,7 +24,8 @@ def check_simulator(config: dict, source: str = "config") -> None:
 
 
 def check_command(config: dict, source: str) -> None:
-    """Templates exist and name only known placeholders; so does the command line; a trace names its columns."""
+    """Templates exist and name only known placeholders; so does the command line (its output, a model, is
+    checked with the other model sections: `config_checks.check_model_sections`)."""
     from shockcal.simulators.templates import COMMAND_ONLY, check_template, placeholder_units
 
     section = config["simulator"]["command"]
@@ -41,7 +42,6 @@ def check_command(config: dict, source: str) -> None:
             raise ConfigError(f"{where}: {path} is not UTF-8 text") from None
         check_template(text, known, f"{where} ({path})")
     check_template(section["command"], {**known, **COMMAND_ONLY}, f"{source}: simulator.command.command")
-    check_output(section["output"], f"{source}: simulator.command.output")
 
 
 def check_output(output: dict, where: str) -> None:
