@@ -70,8 +70,8 @@ def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
 
     params = ShotParameters(A_MPa=170, B_MPa=425, C=0.0335, n=0.42, m=1.225, velocity_m_s=204, shear_modulus_GPa=26.9)
     coarse, al5083 = HydroSettings(cell_size_um=20.0), load_material("al5083")
-    full = run_shot(params, Geometry(3.95, 5.965, 2.30), al5083, coarse)
-    short = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=1.2, rise_fraction=0.003), al5083,
+    full = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.30), al5083, coarse)
+    short = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.30, stop_after_rise_us=1.2, rise_fraction=0.003), al5083,
                      coarse)
     n = len(short.t_us)
     # bit for bit: one code path in one process, the same steps and arithmetic, only stopped sooner
@@ -81,7 +81,8 @@ def test_a_run_that_ends_after_its_rise_is_the_longer_runs_prefix():
     np.testing.assert_array_equal(short.v_m_s, full.v_m_s[:n])
     np.testing.assert_array_equal(short.energy_history, full.energy_history[:n])
     assert short.n_steps < full.n_steps
-    late = run_shot(params, Geometry(3.95, 5.965, 2.30, stop_after_rise_us=5.0, rise_fraction=0.003), al5083, coarse)
+    late = run_shot(params, Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.30, stop_after_rise_us=5.0, rise_fraction=0.003),
+                    al5083, coarse)
     np.testing.assert_array_equal(late.v_m_s, full.v_m_s)                   # end_us comes first
 
 
@@ -90,9 +91,9 @@ def test_a_stop_after_the_rise_needs_both_settings():
     from shockcal.hydro import Geometry
 
     with pytest.raises(InputError, match="Geometry.stop_after_rise_us and Geometry.rise_fraction: give both"):
-        Geometry(3.95, 5.965, 2.3, stop_after_rise_us=1.2)
+        Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.3, stop_after_rise_us=1.2)
     with pytest.raises(InputError, match="Geometry.rise_fraction"):
-        Geometry(3.95, 5.965, 2.3, stop_after_rise_us=1.2, rise_fraction=-0.1)
+        Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.3, stop_after_rise_us=1.2, rise_fraction=-0.1)
 
 
 @pytest.mark.parametrize("runs", [pytest.param(EARLY, id="early"),

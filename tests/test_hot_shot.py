@@ -39,7 +39,7 @@ def test_room_temperature_shot_is_the_code_before_bit_for_bit(paper_config):
     spec = {"flyer_mm": 1.0, "target_mm": 1.5}
     runs = [run_shot(params, *hydro_inputs(paper_config, spec)),
             run_shot(params, *hydro_inputs(paper_config, {**spec, "initial_temperature_K": 298.0})),
-            run_shot(params, Geometry(1.0, 1.5, 0.6, initial_temperature_K=298.0), AL5083)]
+            run_shot(params, Geometry(flyer_mm=1.0, target_mm=1.5, end_us=0.6, initial_temperature_K=298.0), AL5083)]
     for result in runs:
         np.testing.assert_allclose(result.v_m_s, stored["gray_104"], rtol=1e-10, atol=1e-10 * np.max(np.abs(stored["gray_104"])))
         np.testing.assert_array_equal(result.v_m_s, runs[0].v_m_s)
@@ -73,7 +73,7 @@ def test_hot_plates_at_rest_stay_at_rest():
     impact velocity must be positive (`shockcal.hydro.rules`): 1e-12 m/s stands for none, a thousandth of the
     bound on the free surface's motion."""
     result = run_shot(ShotParameters.from_table_iv(A_MBAR, 0.0, 0.0, 0.0, M, 1e-16, G_MBAR),
-                      Geometry(0.5, 0.5, 0.2, initial_temperature_K=700.0), AL5083)
+                      Geometry(flyer_mm=0.5, target_mm=0.5, end_us=0.2, initial_temperature_K=700.0), AL5083)
     assert result.status == "ok", result.reason
     assert np.max(np.abs(result.v_m_s)) < 1e-9
 
@@ -116,7 +116,7 @@ def _elastic_plateau(T0: float) -> float:
     tests read it: the median 20-45 ns after the elastic arrival, before the plastic wave."""
     t_elastic = TARGET_MM * 0.1 / _c_long(T0)
     result = run_shot(ShotParameters.from_table_iv(A_MBAR, 0.0, 0.0, 0.0, M, 0.0204, G_MBAR),
-                      Geometry(FLYER_MM, TARGET_MM, t_elastic + 0.06, initial_temperature_K=T0), AL5083,
+                      Geometry(flyer_mm=FLYER_MM, target_mm=TARGET_MM, end_us=t_elastic + 0.06, initial_temperature_K=T0), AL5083,
                       HydroSettings(cell_size_um=4.0))
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s

@@ -200,7 +200,8 @@ def test_elastic_precursor_is_the_laws_hel(model):
     expected, speed = _yield_jump(law, values, G)
     target_mm = 6.0
     t_elastic = target_mm * 0.1 / speed
-    result = run_shot(LawShotParameters(model, values, V_104S, G), Geometry(2.0, target_mm, t_elastic + 0.05), AL5083)
+    result = run_shot(LawShotParameters(model, values, V_104S, G),
+                      Geometry(flyer_mm=2.0, target_mm=target_mm, end_us=t_elastic + 0.05), AL5083)
     assert result.status == "ok", result.reason
     t, v = result.t_us, result.v_m_s
     plateau = np.median(v[(t > t_elastic + 0.02) & (t < t_elastic + 0.045)])
@@ -230,7 +231,7 @@ def test_law_kernels_load_from_numba_cache_in_a_second_process(tmp_path):
               "from shockcal.hydro.material_library import load_material\n"
               "from shockcal.hydro.solver import simulate\n"
               f"params = LawShotParameters('sg', {STEINBERG_6061!r}, 204.0)\n"
-              "assert run_shot(params, Geometry(0.05, 0.05, 0.01), load_material('al5083')).status == 'ok'\n"
+              "assert run_shot(params, Geometry(flyer_mm=0.05, target_mm=0.05, end_us=0.01), load_material('al5083')).status == 'ok'\n"
               "print(len(simulate.stats.cache_hits), len(simulate.stats.cache_misses))\n")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     first, second = (subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)

@@ -23,7 +23,7 @@ JC_104S = dict(A_MPa=335.0, B_MPa=425.0, C=0.0335, n=0.42, m=1.225, shear_modulu
     (lambda: Geometry(flyer_mm=3.95, target_mm=-5.965, end_us=2.2), "Geometry.target_mm: -5.965 is not a positive number"),
     (lambda: Geometry(flyer_mm=3.95, target_mm=0.0, end_us=2.2), "Geometry.target_mm: 0 is not a positive number"),
     (lambda: Geometry(flyer_mm=np.nan, target_mm=5.965, end_us=2.2), "Geometry.flyer_mm: nan is not a positive number"),
-    (lambda: Geometry(3.95, 5.965, 2.2, initial_temperature_K=-10.0),
+    (lambda: Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.2, initial_temperature_K=-10.0),
      "Geometry.initial_temperature_K: -10 is not a positive number"),
     (lambda: ShotParameters(**JC_104S, velocity_m_s=-204), "ShotParameters.velocity_m_s: -204 is not a positive number"),
     (lambda: ShotParameters(**JC_104S, velocity_m_s=204000),
@@ -57,8 +57,8 @@ def test_a_plate_thinner_than_one_cell_is_refused_before_the_run():
 
 
 @pytest.mark.parametrize("section, key, value, library", [
-    ("shots.104S", "target_mm", 0.0, lambda: Geometry(3.95, 0.0, 2.2)),
-    ("shots.104S", "flyer_mm", -3.95, lambda: Geometry(-3.95, 5.965, 2.2)),
+    ("shots.104S", "target_mm", 0.0, lambda: Geometry(flyer_mm=3.95, target_mm=0.0, end_us=2.2)),
+    ("shots.104S", "flyer_mm", -3.95, lambda: Geometry(flyer_mm=-3.95, target_mm=5.965, end_us=2.2)),
     ("shots.104S", "target_mm", 0.001, lambda: HydroSettings().cells(0.001, "Geometry.target_mm")),
     ("hydro", "cfl", 1.5, lambda: HydroSettings(cfl=1.5)),
     ("hydro", "q_quadratic", -1.0, lambda: HydroSettings(q_quadratic=-1.0)),

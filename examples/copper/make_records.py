@@ -47,7 +47,7 @@ def make_record(velocity_m_s: float, noise: str, level: float, cell_size_um: flo
     from shockcal.hydro.material_library import load_material
 
     params = ShotParameters(velocity_m_s=velocity_m_s, **TRUTH)
-    run = run_shot(params, Geometry(FLYER_MM, TARGET_MM, END_US), load_material(MATERIAL),
+    run = run_shot(params, Geometry(flyer_mm=FLYER_MM, target_mm=TARGET_MM, end_us=END_US), load_material(MATERIAL),
                    HydroSettings(cell_size_um=cell_size_um))
     if run.status != "ok":
         raise SystemExit(f"make_records: the {velocity_m_s:g} m/s run failed: {run.reason}")

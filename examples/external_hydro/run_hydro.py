@@ -45,7 +45,8 @@ def simulate(deck: dict):
 
     params = ShotParameters.from_table_iv(deck["A_Mbar"], deck["B_Mbar"], deck["C"], deck["n"], deck["m"],
                                           deck["velocity_cm_us"], deck["shear_modulus_Mbar"])
-    geometry = Geometry(deck["flyer_mm"], deck["target_mm"], deck["end_time_us"], deck["initial_temperature_K"])
+    geometry = Geometry(flyer_mm=deck["flyer_mm"], target_mm=deck["target_mm"], end_us=deck["end_time_us"],
+                        initial_temperature_K=deck["initial_temperature_K"])
     material = MaterialProperties(**{k: deck[k] for k in MaterialProperties.model_fields if k in deck})
     settings = HydroSettings(**{k: deck[k] for k in HydroSettings.model_fields})
     result = run_shot(params, geometry, material, settings)

@@ -8,13 +8,12 @@ These are what `run_shot` takes; each converts itself to the kernel's named tupl
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from pydantic import model_validator
 
 from shockcal.errors import InputError
 from shockcal.hydro.eos import bulk_sound_speed_sq, zero_pressure_compression
-from shockcal.hydro.rules import check_fields, melting_problem, plate_problem
+from shockcal.hydro.rules import melting_problem, plate_problem
 from shockcal.hydro.settings_model import SettingsModel, setting
 from shockcal.hydro.state import InitialState, Material, Numerics
 from shockcal.settings_model import SettingsError, section_fields
@@ -23,36 +22,44 @@ from shockcal.units import CM_US_TO_M_S, J_PER_KG_TO_CODE, MM_TO_CM, NS_TO_US, P
 EOS = "material.eos"      # the config section of the equation of state's coefficients (MaterialProperties)
 
 
-@dataclass(frozen=True)
-class Geometry:
-    """A symmetric plate impact; checked on creation (`shockcal.hydro.rules`: an InputError naming the field).
+class Plates(SettingsModel):
+    """A symmetric shot's plates: the study config's `shots.<shot>` section's keys that the hydrocode reads (the
+    section's other keys map the design's inputs onto the shot and set its analysis window). Each field's rule
+    and description is here once; the config schema's entries are generated from them. Checked on creation: a
+    SettingsError (an InputError) naming the class and the field."""
 
-    Args:
-        flyer_mm: flyer plate thickness (mm), at the shot's initial temperature (the hot thickness of a
-            heated shot).
-        target_mm: target plate thickness (mm), likewise; the measured free surface is its back.
-        end_us: simulated time after impact (us).
-        initial_temperature_K: temperature of both plates before impact (K); None: the material's
-            T_ref_K (a room-temperature shot). Hotter plates start expanded, at zero pressure
-            (`MaterialProperties.initial_state`).
-        stop_after_rise_us: end the run this long (us) after its free-surface velocity first exceeds
-            `rise_fraction` x its impact velocity, or at end_us if sooner; None: at end_us.
-        rise_fraction: that share of the impact velocity (-), with stop_after_rise_us.
+    flyer_mm: float = setting(..., "Flyer plate thickness.", "positive")
+    target_mm: float = setting(..., "Target plate thickness (the VISAR measures the velocity of its free surface).",
+                               "positive")
+    initial_temperature_K: float | None = setting(
+        None, "Temperature of both plates before impact, below material.T_melt_K. Left out: the material's T_ref_K "
+              "(a room-temperature shot, every run bit for bit as before, and no simulation reruns, since the "
+              "simulate stage's params hold the key only when it is given). Hotter plates start at rest and zero "
+              "pressure, expanded as the EOS says (E0 = cv (T0 - T_ref), density from P(rho, E0) = 0), and "
+              "Johnson-Cook softened by their T*. flyer_mm and target_mm are then the hot thicknesses (docs/hydro.md, "
+              "\"Initial temperature\").", "positive", optional=True)
+
+
+class Geometry(Plates):
+    """A symmetric plate impact, its plates (`Plates`) and how long to run it; checked on creation (an InputError
+    naming the field). None of these three fields is a config key: the study sets them from `hydro.end_time_us`
+    and the shot's analysis window (`shockcal.study.adapters.hydro_inputs`).
+
+        Geometry(flyer_mm=3.95, target_mm=5.965, end_us=2.2)
     """
 
-    flyer_mm: float
-    target_mm: float
-    end_us: float
-    initial_temperature_K: float | None = None
-    stop_after_rise_us: float | None = None
-    rise_fraction: float | None = None
+    end_us: float = setting(..., "Simulated time after impact (us).", "positive")
+    stop_after_rise_us: float | None = setting(
+        None, "End the run this long (us) after its free-surface velocity first exceeds rise_fraction x its impact "
+              "velocity, or at end_us if sooner; None: at end_us.", "positive")
+    rise_fraction: float | None = setting(None, "That share of the impact velocity (-), with stop_after_rise_us.",
+                                          "positive")
 
-    def __post_init__(self):
-        check_fields(self, {"flyer_mm": "positive", "target_mm": "positive", "end_us": "positive",
-                            "initial_temperature_K": "positive", "stop_after_rise_us": "positive",
-                            "rise_fraction": "positive"})
+    @model_validator(mode="after")
+    def _stop_both_or_neither(self):
         if (self.stop_after_rise_us is None) != (self.rise_fraction is None):
             raise InputError("Geometry.stop_after_rise_us and Geometry.rise_fraction: give both or neither")
+        return self
 
 
 class MaterialProperties(SettingsModel):

@@ -70,16 +70,14 @@ def hydro_inputs(config: dict, spec: dict, end_us: float | None = None
     """`run_shot`'s inputs for a shot besides its parameters: (Geometry, MaterialProperties,
     HydroSettings). `spec` is the shot's config section (`shot_config(config, shot)`); `end_us` (us)
     defaults to the config's end time (`end_time_us`; with `per_run` each run also ends the analysis window
-    plus AUTO_END_MARGIN_US after its free surface's rise); the shot's `initial_temperature_K` (K), absent
-    or null, is the material's T_ref_K."""
+    plus AUTO_END_MARGIN_US after its free surface's rise); the shot's `initial_temperature_K` (K), left out, is
+    the material's T_ref_K."""
     per_run = end_us is None and config["hydro"]["end_time_us"] == "per_run"
     end_us = end_time_us(config, spec) if end_us is None else end_us
-    temperature = spec.get("initial_temperature_K")
-    stop = (float(spec["analysis"]["window_after_arrival_us"]) + AUTO_END_MARGIN_US, PER_RUN_RISE_FRACTION) if per_run \
-        else (None, None)
-    return (Geometry(float(spec["flyer_mm"]), float(spec["target_mm"]), float(end_us),
-                     None if temperature is None else float(temperature), *stop),
-            material_properties(config), hydro_settings(config))
+    stop = {"stop_after_rise_us": float(spec["analysis"]["window_after_arrival_us"]) + AUTO_END_MARGIN_US,
+            "rise_fraction": PER_RUN_RISE_FRACTION} if per_run else {}
+    return (Geometry.from_section(spec, end_us=float(end_us), **stop), material_properties(config),
+            hydro_settings(config))
 
 
 def extractor_settings(config: dict, shot: str) -> ExtractorSettings:

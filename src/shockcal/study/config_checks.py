@@ -25,11 +25,21 @@ def check_model_sections(config: dict, source: str = "config") -> None:
     say (`calibration.replicates` 2) in the model's words, naming the key. A section given as a word (a
     discrepancy `none`) has none to check."""
     for section, model in MODEL_SECTIONS.items():
-        values = config
-        for key in section.split("."):
-            values = values.get(key) if isinstance(values, dict) else None
-        if isinstance(values, dict):
-            _section_model(model, values, section, source)
+        for where, values in _sections(config, section.split(".")):
+            if isinstance(values, dict):
+                _section_model(model, values, where, source)
+
+
+def _sections(node, keys: list[str], where: str = ""):
+    """(key path, values) of each config section a dotted path names (`*`: every key of a mapping; `shots.*`:
+    each shot's), none where the config lacks the key."""
+    if not keys:
+        yield where.removeprefix("."), node
+        return
+    if not isinstance(node, dict):
+        return
+    for key in (node if keys[0] == "*" else [keys[0]] if keys[0] in node else []):
+        yield from _sections(node[key], keys[1:], f"{where}.{key}")
 
 
 def _section_model(model, values: dict, section: str, source: str):

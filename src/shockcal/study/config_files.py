@@ -31,7 +31,7 @@ from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettin
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws.settings import StrengthSettings
-from shockcal.hydro.settings import HydroSettings, MaterialProperties
+from shockcal.hydro.settings import HydroSettings, MaterialProperties, Plates
 from shockcal.inference.settings import (
     CheckSettings,
     DiscrepancySettings,
@@ -58,7 +58,7 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest. A
 # field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there. A
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
-MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "emulator": EmulatorSettings,
+MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots.*": Plates, "emulator": EmulatorSettings,
                   "features": ExtractorSettings, "calibration": SamplerSettings, "calibration.check": CheckSettings,
                   "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings, "design": DesignSettings,
                   "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
