@@ -50,6 +50,39 @@ def test_a_sampler_setting_is_outside_every_stage_but_the_calibration(config):
     assert readers == {"calibrate"}
 
 
+def test_a_models_keys_are_its_fields_and_the_sections_they_name():
+    """`model_keys`: each field once, in order, as its section's key; a field of another section by that section;
+    an optional field marked (sliced only when given) or left out; a field given by a key of its own not at all."""
+    from shockcal.settings_model import SettingsModel, setting
+    from shockcal.study.stages import model_keys
+
+    class Toy(SettingsModel):
+        first: float = setting(1.0, "a key of the section")
+        a: float = setting(1.0, "a key of the section's sub-section", section="toy.sub")
+        b: float = setting(1.0, "the same sub-section", section="toy.sub")
+        maybe: float | None = setting(None, "left out: not given", optional=True)
+        seed: int = setting(0, "a key of its own", key="study.seed")
+
+    assert model_keys(Toy, "toy") == ("toy.first", "toy.sub", "toy.maybe?")
+    assert model_keys(Toy, "toy", optional=False) == ("toy.first", "toy.sub")
+
+
+def test_the_simulate_stage_reads_every_plate_and_material_key(config):
+    """What the hydrocode takes, Plates and MaterialProperties, is in the simulate slice, field by field: a field
+    either model gains reruns the simulations without a line in stages.py (the law-specific material constants,
+    optional, only for a law that reads them)."""
+    from shockcal.hydro.settings import MaterialProperties, Plates
+    from shockcal.settings_model import OPTIONAL, SECTION, schema_extras
+
+    sliced = stage_config(config, "simulate", "104S")
+    assert {name for name in Plates.model_fields if name in config["shots"]["104S"]} <= set(sliced["shots"]["104S"])
+    extras = schema_extras(MaterialProperties)
+    constants = {name for name, extra in extras.items() if SECTION not in extra and not extra.get(OPTIONAL)}
+    assert constants | {"eos"} <= set(sliced["material"]) and "name" not in sliced["material"]
+    law_specific = {name for name, extra in extras.items() if extra.get(OPTIONAL)}
+    assert law_specific & set(config["material"]) and not law_specific & set(sliced["material"])   # Johnson-Cook's
+
+
 def test_the_slice_is_a_copy(config):
     sliced = stage_config(config, "emulate")
     sliced["emulator"]["structure"] = "per_shot"

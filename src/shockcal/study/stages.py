@@ -19,20 +19,36 @@ from __future__ import annotations
 import copy
 from collections.abc import Iterable, Iterator
 
+from shockcal.hydro.settings import MaterialProperties, Plates
 from shockcal.inference.settings import SamplerSettings
-from shockcal.settings_model import section_fields
+from shockcal.settings_model import KEY, OPTIONAL, SECTION, SettingsModel, schema_extras
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
 from shockcal.study.strength_config import strength_law, strength_model
 from shockcal.study.validate import load_config
 
-_SHOT_GEOMETRY = ("flyer_mm", "target_mm", "initial_temperature_K?", "velocity_input", "shear_modulus_inputs")
+
+def model_keys(model: type[SettingsModel], section: str, optional: bool = True) -> tuple[str, ...]:
+    """The config keys of `model`'s fields, in field order: `section.<field>`, or the section a field names
+    (`setting(section=...)`: `material.eos`), once; an optional field's with `?` (sliced only when given), or
+    none with `optional` false. A field the model gains is read, and reruns the stage, with no line here."""
+    keys = []
+    for name, extra in schema_extras(model).items():
+        if KEY in extra or (extra.get(OPTIONAL) and not optional):
+            continue
+        key = f"{section}.{name}?" if extra.get(OPTIONAL) else extra.get(SECTION, f"{section}.{name}")
+        keys += [key] if key not in keys else []
+    return tuple(keys)
+
+
+# a shot's plates (`Plates`) and how it reads a design row
+_SHOT_GEOMETRY = (*model_keys(Plates, "shots.{shot}"), "shots.{shot}.velocity_input", "shots.{shot}.shear_modulus_inputs")
 _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "strength.model?")
 
-# the material's constants, not its library `name` (`shockcal.hydro.material_library`): a config naming its material and one
-# giving the same values run the same jobs
-_MATERIAL = ("material.rho0_g_cc", "material.eos", "material.T_ref_K", "material.T_melt_K", "material.cv_J_per_kg_K",
-             "material.strain_rate_ref_per_s")
+# the material's constants (`MaterialProperties`), not its library `name` (`shockcal.hydro.material_library`): a config
+# naming its material and one giving the same values run the same jobs; the constants only some laws read (optional)
+# are sliced for those laws only (`_law_material_keys`)
+_MATERIAL = model_keys(MaterialProperties, "material", optional=False)
 
 # what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window;
 # `adapters.candidate`: the study's law and its inputs)
@@ -42,7 +58,7 @@ _CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log
 
 # the sampler's keys, SamplerSettings' fields (`sampler_settings` reads them by name): a new field is read, and
 # reruns the calibrations, with no line here
-_SAMPLER = tuple(f"calibration.{name}" for name in section_fields(SamplerSettings))
+_SAMPLER = model_keys(SamplerSettings, "calibration")
 
 STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the training design: a Latin hypercube of the box, or the design file checked against it
@@ -53,7 +69,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
                      *_SHOT_MAPPING),
     # one shot's hydrocode runs; the analysis window sets the simulated time when end_time_us is auto or per_run
     "simulate": (*_MATERIAL, "hydro", "checks.design_box", "inputs.{shot_inputs}", "strength.model?", "simulator?",
-                 *(f"shots.{{shot}}.{key}" for key in _SHOT_GEOMETRY),
+                 *_SHOT_GEOMETRY,
                  "shots.{shot}.analysis.window_after_arrival_us"),
     # features of one shot's traces (one chunk, or a whole run set with the failure budget)
     "features": ("features", "shots.{shot}.analysis"),
