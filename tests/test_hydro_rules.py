@@ -8,6 +8,7 @@ import copy
 import numpy as np
 import pytest
 
+from shockcal.campaign.candidates import CandidateShot
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import Geometry, HydroSettings, LawShotParameters, MaterialProperties, ShotParameters
 from shockcal.hydro.material_library import load_material
@@ -56,6 +57,9 @@ def test_a_plate_thinner_than_one_cell_is_refused_before_the_run():
         run_shot(params, Geometry(flyer_mm=3.95, target_mm=0.001, end_us=0.1), AL5083)
 
 
+FAST = {"flyer_mm": 3.95, "target_mm": 5.965, "velocity_m_s": 204}     # a next-shot candidate's plates and velocity
+
+
 @pytest.mark.parametrize("section, key, value, library", [
     ("shots.104S", "target_mm", 0.0, lambda: Geometry(flyer_mm=3.95, target_mm=0.0, end_us=2.2)),
     ("shots.104S", "flyer_mm", -3.95, lambda: Geometry(flyer_mm=-3.95, target_mm=5.965, end_us=2.2)),
@@ -67,12 +71,15 @@ def test_a_plate_thinner_than_one_cell_is_refused_before_the_run():
     ("material", "T_melt_K", 250.0, lambda: MaterialProperties(**{**AL5083.__dict__, "T_melt_K": 250.0})),
     ("next_shot.candidates.fast", "velocity_m_s", 204000, lambda: ShotParameters(**JC_104S, velocity_m_s=204000)),
     ("next_shot.candidates.fast", "velocity_m_s", -204, lambda: ShotParameters(**JC_104S, velocity_m_s=-204)),
+    ("next_shot.candidates.fast", "velocity_m_s", 204000, lambda: CandidateShot(**{**FAST, "velocity_m_s": 204000})),
+    ("next_shot.candidates.fast", "target_mm", 0.0, lambda: CandidateShot(**{**FAST, "target_mm": 0.0})),
+    ("next_shot.candidates.fast", "initial_temperature_K", -10.0,
+     lambda: CandidateShot(**FAST, initial_temperature_K=-10.0)),
 ])
 def test_the_config_gives_the_librarys_message(paper_config, section, key, value, library):
     """One rule behind both doors: after its key, the config's message is the library's word for word."""
     config = copy.deepcopy(paper_config)
-    config["next_shot"]["candidates"]["fast"] = {"shot": "104S", "flyer_mm": 3.95, "target_mm": 5.965,
-                                                 "velocity_m_s": 204}
+    config["next_shot"]["candidates"]["fast"] = {"shot": "104S", **FAST}
     node = config
     for part in section.split("."):
         node = node[part]

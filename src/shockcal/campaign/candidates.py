@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -28,6 +27,8 @@ from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
 from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, get_law
+from shockcal.hydro.settings import Plates
+from shockcal.hydro.settings_model import setting
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
 
@@ -39,21 +40,24 @@ SPLIT_STRAIN_RATE_PER_S = 1.0e6   # the elastic front's strain rate for the HEL 
 SPLIT_SHARE = 0.5                 # the share of draws without an elastic-plastic split that stops a candidate
 
 
-@dataclass(frozen=True)
-class Candidate:
-    """A candidate shot: its plates (mm, hot thicknesses when heated), nominal impact velocity (m/s),
-    initial temperature (K; None: the material's T_ref_K) and the design inputs whose sum is its
-    reference shot's shear modulus (Mbar); the study's strength law (`model`) and its design columns
-    (`strength_inputs`, `shockcal.hydro.laws.Law.column`), which the posterior's draws give."""
+class CandidateShot(Plates):
+    """A next-shot candidate as the config gives it (`next_shot.candidates.<name>`, the schema's `candidate`
+    entry, generated from these fields): a shot's plates (`Plates`, hot thicknesses when heated) and its nominal
+    impact velocity. Checked on creation: a SettingsError naming the class and the field."""
 
-    name: str
-    flyer_mm: float
-    target_mm: float
-    velocity_m_s: float
-    initial_temperature_K: float | None
-    shear_modulus_inputs: tuple[str, ...]
-    model: str = DEFAULT_MODEL
-    strength_inputs: tuple[str, ...] = DEFAULT_COLUMNS
+    velocity_m_s: float = setting(..., "Nominal impact velocity.", "impact_velocity_m_s")
+
+
+class Candidate(CandidateShot):
+    """A candidate shot (`CandidateShot`: plates, initial temperature, None the material's T_ref_K, nominal impact
+    velocity) with what the study gives it: the design inputs whose sum is its reference shot's shear modulus
+    (Mbar), the study's strength law (`model`) and its design columns (`strength_inputs`,
+    `shockcal.hydro.laws.Law.column`), which the posterior's draws give."""
+
+    name: str = setting(..., "The candidate's name.")
+    shear_modulus_inputs: tuple[str, ...] = setting(..., "The design inputs whose sum is its shear modulus (Mbar).")
+    model: str = setting(DEFAULT_MODEL, "The study's strength law.")
+    strength_inputs: tuple[str, ...] = setting(DEFAULT_COLUMNS, "The law's design columns.")
 
     def mapping(self) -> ShotMapping:
         """How the candidate reads its design (`candidate_design`'s velocity and shear-modulus columns)."""

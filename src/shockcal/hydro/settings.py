@@ -33,11 +33,10 @@ class Plates(SettingsModel):
                                "positive")
     initial_temperature_K: float | None = setting(
         None, "Temperature of both plates before impact, below material.T_melt_K. Left out: the material's T_ref_K "
-              "(a room-temperature shot, every run bit for bit as before, and no simulation reruns, since the "
-              "simulate stage's params hold the key only when it is given). Hotter plates start at rest and zero "
-              "pressure, expanded as the EOS says (E0 = cv (T0 - T_ref), density from P(rho, E0) = 0), and "
-              "Johnson-Cook softened by their T*. flyer_mm and target_mm are then the hot thicknesses (docs/hydro.md, "
-              "\"Initial temperature\").", "positive", optional=True)
+              "(a room-temperature shot). Hotter plates start at rest and zero pressure, expanded as the EOS says "
+              "(E0 = cv (T0 - T_ref), density from P(rho, E0) = 0), and Johnson-Cook softened by their T*. flyer_mm "
+              "and target_mm are then the hot thicknesses (docs/hydro.md, \"Initial temperature\").", "positive",
+        optional=True)
 
 
 class Geometry(Plates):

@@ -93,13 +93,12 @@ def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
 def candidate(config: dict, name: str) -> Candidate:
     """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs and the study's law and
     its inputs."""
-    from shockcal.campaign.candidates import Candidate
+    from shockcal.campaign.candidates import Candidate, CandidateShot
 
     spec = candidate_config(config, name)
-    temperature = spec["initial_temperature_K"]
-    return Candidate(name, float(spec["flyer_mm"]), float(spec["target_mm"]), float(spec["velocity_m_s"]),
-                     None if temperature is None else float(temperature), tuple(spec["shear_modulus_inputs"]),
-                     strength_law(config).name, tuple(strength_parameters(config)))
+    return Candidate(name=name, **{key: spec[key] for key in CandidateShot.model_fields},
+                     shear_modulus_inputs=tuple(spec["shear_modulus_inputs"]), model=strength_law(config).name,
+                     strength_inputs=tuple(strength_parameters(config)))
 
 
 def candidate_box(config: dict, name: str) -> InputBox:

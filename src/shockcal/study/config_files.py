@@ -21,6 +21,7 @@ from pathlib import Path
 
 import yaml
 
+from shockcal.campaign.candidates import CandidateShot
 from shockcal.campaign.settings import (
     ModulusSlopeSettings,
     NextShotCheckSettings,
@@ -67,7 +68,8 @@ MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots
                   "figures": FigureSettings, "next_shot": NextShotSettings,
                   "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings,
                   "next_shot.check": NextShotCheckSettings, "observed": ObservedSettings, "strength": StrengthSettings,
-                  "simulator.command": CommandSettings, "definitions.run_output": OutputSpec}
+                  "simulator.command": CommandSettings, "definitions.run_output": OutputSpec,
+                  "definitions.candidate": CandidateShot}
 AFTER = "x-after"     # a YAML key of such a section placed after this key (the order defaults are filled in)
 
 
