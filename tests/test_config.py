@@ -38,7 +38,7 @@ def test_paper_config_is_valid(paper_config):
         ("simulate.chunk_size", 0, r"simulate\.chunk_size: 0 is less than the minimum of 1"),
         ("sensitivity.n_base", 1000, r"sensitivity\.n_base: 1000 is not a power of 2"),
         ("predict.end_time_us", 0, r"predict\.end_time_us: 0 is not a positive number"),
-        ("inputs.A.min", 0.02, r"inputs\.A: min \(0\.02\) must be below max"),
+        ("inputs.A.min", 0.02, r"inputs\.A\.min: 0\.02 is not below max \(0\.01\)"),
         ("inputs.B.min", -0.001, r"inputs\.B\.min: -0\.001 is negative; Johnson-Cook parameters cannot be negative"),
         ("shots.105S.velocity_input", "V9", r"shots\.105S\.velocity_input: 'V9' is not one of the inputs"),
         ("observed.records", {"104S": {"path": "no/such/record.txt"}},

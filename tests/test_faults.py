@@ -270,7 +270,7 @@ def _setting(config, path, value):
     ("hydro.cell_size_um", "four", "hydro.cell_size_um: 'four' is not of type 'number'"),
     ("simulate.chunk_size", 0, "simulate.chunk_size: 0 is less than the minimum of 1"),
     ("checks.design_box", "no", "checks.design_box: 'no' is not of type 'boolean'"),
-    ("inputs.A.min", 0.02, "inputs.A: min (0.02) must be below max"),
+    ("inputs.A.min", 0.02, "inputs.A.min: 0.02 is not below max (0.01)"),
     ("shots.105S.velocity_input", "V9", "shots.105S.velocity_input: 'V9' is not one of the inputs"),
     ("design.file", "no/such/design.csv", "design.file: no/such/design.csv does not exist"),
     ("calibration.replicates", 2, "calibration.replicates: 2 runs give no usable spread"),

@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from shockcal.campaign.candidates import CandidateShot
+from shockcal.design.settings import InputRange
+from shockcal.design.tables import InputBox
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro import Geometry, HydroSettings, LawShotParameters, MaterialProperties, ShotParameters
 from shockcal.hydro.material_library import load_material
@@ -75,6 +77,8 @@ FAST = {"flyer_mm": 3.95, "target_mm": 5.965, "velocity_m_s": 204}     # a next-
     ("next_shot.candidates.fast", "target_mm", 0.0, lambda: CandidateShot(**{**FAST, "target_mm": 0.0})),
     ("next_shot.candidates.fast", "initial_temperature_K", -10.0,
      lambda: CandidateShot(**FAST, initial_temperature_K=-10.0)),
+    ("inputs.A", "min", 0.02, lambda: InputRange(min=0.02, max=0.01, unit="Mbar")),
+    ("inputs.A", "min", 0.02, lambda: InputBox({"A": (0.02, 0.01)}, {"A": "Mbar"})),
 ])
 def test_the_config_gives_the_librarys_message(paper_config, section, key, value, library):
     """One rule behind both doors: after its key, the config's message is the library's word for word."""

@@ -77,7 +77,7 @@ def test_strength_inputs_override_the_models_file(paper_config):
     ({"model": "steinberg-guinan", "inputs": {"A_MPa": {"min": 1, "max": 2}}},
      "strength.inputs.A_MPa: not a parameter of steinberg-guinan"),
     ({"model": "steinberg-guinan", "inputs": {"Y0_GPa": {"min": 0.3}}}, "strength.inputs.Y0_GPa: 'max' is a required property"),
-    ({"model": "steinberg-guinan", "inputs": {"n": {"min": 0.5, "max": 0.1}}}, r"strength.inputs.n: min \(0.5\) must be below max"),
+    ({"model": "steinberg-guinan", "inputs": {"n": {"min": 0.5, "max": 0.1}}}, r"strength.inputs.n.min: 0.5 is not below max \(0.1\)"),
     ({"model": "steinberg-guinan", "inputs": {"Ymax_GPa": {"min": 0.2, "max": 1.0}}}, "breaks the law .*Ymax_GPa >= Y0_GPa"),
     ({"model": "zerilli-armstrong", "inputs": {"C0_MPa": {"min": -50.0, "max": 300.0}}},
      "flow stress is -50 MPa at the box corner C0_MPa=-50"),

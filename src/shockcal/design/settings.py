@@ -8,10 +8,28 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import ValidationInfo, field_validator
+from pydantic import ValidationInfo, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from shockcal.settings_model import SettingsModel, setting
+from shockcal.errors import number
+from shockcal.settings_model import SettingsError, SettingsModel, setting
+
+
+class InputRange(SettingsModel):
+    """One calibrated input's uniform prior box: the study config's `inputs.<name>` (paper Table IV), checked on
+    creation (a SettingsError naming the field) and by `InputBox` for each of its inputs."""
+
+    min: float = setting(..., "Lower bound of the box (below `max`).", unit="the input's `unit`")
+    max: float = setting(..., "Upper bound of the box.", unit="the input's `unit`")
+    unit: str = setting(..., "Unit of the bounds and of the input's design and posterior columns, written into the "
+                             "tables' metadata (`Mbar`, `cm/us`, or `-` when dimensionless).")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not self.min < self.max:
+            reason = f"{number(self.min)} is not below max ({number(self.max)})"
+            raise SettingsError(f"InputRange.min: {reason}", "min", reason)
+        return self
 
 
 class DesignSettings(SettingsModel):

@@ -17,11 +17,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from shockcal.design.settings import InputRange
 from shockcal.errors import InputError, number, shown
 from shockcal.hydro import LawShotParameters, ShotParameters
 from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, get_law
 from shockcal.io import integer_ids, read_table, require_columns
 from shockcal.plausibility import outside_box, range_problem
+from shockcal.settings_model import SettingsError
 from shockcal.units import CM_US_TO_M_S, MBAR_TO_GPA
 
 log = logging.getLogger("shockcal.design.tables")
@@ -43,6 +45,14 @@ class InputBox:
     units: Mapping[str, str]
     velocity_of: Mapping[str, str] = field(default_factory=dict)
     strict: bool = True
+
+    def __post_init__(self):
+        """Each input's bounds and unit as the config's `inputs.<name>` (`InputRange`): an InputError naming it."""
+        for name, (low, high) in self.bounds.items():
+            try:
+                InputRange(min=low, max=high, unit=self.units.get(name, ""))
+            except SettingsError as exc:
+                raise InputError(f"InputBox.bounds.{name}.{exc.field}: {exc.reason}") from None
 
     def names(self) -> list[str]:
         """The inputs in the box's order (a design table's columns after `run`)."""

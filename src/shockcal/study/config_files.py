@@ -28,7 +28,7 @@ from shockcal.campaign.settings import (
     NextShotSettings,
     SensitivitySettings,
 )
-from shockcal.design.settings import DesignSettings, NewShotSettings, WaveSettings
+from shockcal.design.settings import DesignSettings, InputRange, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws.settings import StrengthSettings
@@ -59,13 +59,13 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # generated from the model (`shockcal.settings_model.schema_properties`), the YAML holds only the rest. A
 # field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there. A
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
-MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots.*": Plates, "emulator": EmulatorSettings,
-                  "features": ExtractorSettings, "calibration": SamplerSettings, "calibration.check": CheckSettings,
-                  "calibration.discrepancy": DiscrepancySettings, "verify": VerifySettings, "design": DesignSettings,
-                  "design.new_shots": NewShotSettings, "design.waves": WaveSettings,
-                  "design.waves.step_calibration": StepSamplerSettings, "checks": ChecksSettings,
-                  "simulate": SimulateSettings, "predict": PredictSettings, "sensitivity": SensitivitySettings,
-                  "figures": FigureSettings, "next_shot": NextShotSettings,
+MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots.*": Plates, "inputs.*": InputRange,
+                  "emulator": EmulatorSettings, "features": ExtractorSettings, "calibration": SamplerSettings,
+                  "calibration.check": CheckSettings, "calibration.discrepancy": DiscrepancySettings,
+                  "verify": VerifySettings, "design": DesignSettings, "design.new_shots": NewShotSettings,
+                  "design.waves": WaveSettings, "design.waves.step_calibration": StepSamplerSettings,
+                  "checks": ChecksSettings, "simulate": SimulateSettings, "predict": PredictSettings,
+                  "sensitivity": SensitivitySettings, "figures": FigureSettings, "next_shot": NextShotSettings,
                   "next_shot.shear_modulus_log_slope_per_K": ModulusSlopeSettings,
                   "next_shot.check": NextShotCheckSettings, "observed": ObservedSettings, "strength": StrengthSettings,
                   "simulator.command": CommandSettings, "definitions.run_output": OutputSpec,

@@ -17,9 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from shockcal.design.settings import InputRange
 from shockcal.errors import ConfigError, InputError
 from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, Law, flow_stress_at_states, get_law, law_values
 from shockcal.hydro.laws.boxes import load_boxes
+from shockcal.settings_model import SettingsError
 
 # states at which a box's corners must give a finite, non-negative flow stress:
 # (plastic strain, equivalent strain rate 1/s, temperature K, pressure GPa, density ratio)
@@ -87,9 +89,10 @@ def apply_strength_model(config: dict, source: str) -> None:
                               f"(give min and max, or a low/high in {models_file})")
         else:
             continue
-        if not low < high:
-            raise ConfigError(f"{source}: {where}: min ({low}) must be below max ({high})")
-        box[param.name] = {"min": float(low), "max": float(high), "unit": param.unit}
+        try:
+            box[param.name] = InputRange(min=low, max=high, unit=param.unit).model_dump()
+        except SettingsError as exc:
+            raise ConfigError(f"{source}: {where}.{exc.field}: {exc.reason}") from None
     check_corners(law, box, material_constants(config, law.name, box, source), source)
     config["inputs"] = {**box, **_shot_inputs(config, law, given, source)}
     section["inputs"] = {name: {"min": b["min"], "max": b["max"]} for name, b in box.items()}   # idempotent
