@@ -8,7 +8,7 @@ import copy
 import numpy as np
 import pytest
 
-from shockcal.campaign.candidates import CandidateShot
+from shockcal.campaign.settings import CandidateShot
 from shockcal.design.settings import InputRange
 from shockcal.design.tables import InputBox
 from shockcal.errors import ConfigError, InputError

@@ -22,12 +22,12 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from shockcal.campaign.settings import CandidateShot
 from shockcal.design.posterior_draws import draw_posterior_design
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import InputError
 from shockcal.hydro import MaterialProperties
 from shockcal.hydro.laws import DEFAULT_COLUMNS, DEFAULT_MODEL, get_law
-from shockcal.hydro.settings import Plates
 from shockcal.hydro.settings_model import setting
 from shockcal.inference.problem import LAMBDA_Y
 from shockcal.units import CM_US_TO_M_S, PER_S_TO_PER_US
@@ -38,14 +38,6 @@ VELOCITY_FACTOR = "velocity_factor"
 SLOPE = "shear_modulus_log_slope_per_K"
 SPLIT_STRAIN_RATE_PER_S = 1.0e6   # the elastic front's strain rate for the HEL (the shots' peak rates: 0.7-3.4 /us)
 SPLIT_SHARE = 0.5                 # the share of draws without an elastic-plastic split that stops a candidate
-
-
-class CandidateShot(Plates):
-    """A next-shot candidate as the config gives it (`next_shot.candidates.<name>`, the schema's `candidate`
-    entry, generated from these fields): a shot's plates (`Plates`, hot thicknesses when heated) and its nominal
-    impact velocity. Checked on creation: a SettingsError naming the class and the field."""
-
-    velocity_m_s: float = setting(..., "Nominal impact velocity.", "impact_velocity_m_s")
 
 
 class Candidate(CandidateShot):

@@ -1,7 +1,8 @@
 """The campaign's questions as settings models: which shot next (the study config's `next_shot` section, its
 modulus slope and its realized check) and which inputs matter (`sensitivity`). Each field's default, limits
 and description is here once; the config schema's entries are generated from them (`shockcal.settings_model`).
-The candidates themselves (`next_shot.candidates`, `grid`) are `shockcal.campaign.candidates.Candidate`s."""
+A candidate as the config gives it (`next_shot.candidates.<name>`) is a `CandidateShot`; with what the study gives
+it, a `shockcal.campaign.candidates.Candidate`."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from typing import Annotated
 from pydantic import Field, ValidationInfo, field_validator
 from pydantic_core import PydanticCustomError
 
+from shockcal.hydro.settings import Plates
+from shockcal.hydro.settings_model import setting as hydro_setting
 from shockcal.inference.settings import MIN_N_EFF, MIN_N_LIVE
 from shockcal.settings_model import SettingsModel, setting
 from shockcal.velocimetry.columns import CALIBRATION_FEATURES
@@ -118,3 +121,11 @@ class NextShotCheckSettings(SettingsModel):
             raise PydanticCustomError("same", "compares {name} with itself; name two candidates",
                                       {"name": candidates[0]})
         return candidates
+
+
+class CandidateShot(Plates):
+    """A next-shot candidate as the config gives it (`next_shot.candidates.<name>`, the schema's `candidate`
+    entry, generated from these fields): a shot's plates (`Plates`, hot thicknesses when heated) and its nominal
+    impact velocity. Checked on creation: a SettingsError naming the class and the field."""
+
+    velocity_m_s: float = hydro_setting(..., "Nominal impact velocity.", "impact_velocity_m_s")

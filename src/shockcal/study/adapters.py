@@ -93,7 +93,8 @@ def candidate_extractor_settings(config: dict, name: str) -> ExtractorSettings:
 def candidate(config: dict, name: str) -> Candidate:
     """`next_shot.candidates.<name>` with its reference shot's shear-modulus inputs and the study's law and
     its inputs."""
-    from shockcal.campaign.candidates import Candidate, CandidateShot
+    from shockcal.campaign.candidates import Candidate
+    from shockcal.campaign.settings import CandidateShot
 
     spec = candidate_config(config, name)
     return Candidate(name=name, **{key: spec[key] for key in CandidateShot.model_fields},

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import yaml
 
-from shockcal.campaign.candidates import CandidateShot
 from shockcal.campaign.settings import (
+    CandidateShot,
     ModulusSlopeSettings,
     NextShotCheckSettings,
     NextShotSettings,
