@@ -19,17 +19,19 @@ OBSERVED = (69.7, 199.4, 79.5, 186.4)
 BOX = BoxSensitivity(2, -46.0, 0.1, -47.5, 0.2)
 
 
-def test_bayes_factors_against_johnson_cook():
-    table = evidence_table({
-        "johnson-cook": ModelResult(("A", "B"), -45.0, 0.03, OBSERVED, 12.0, 20.0, BOX),
-        "steinberg-guinan": ModelResult(("Y0_GPa", "n", "V1"), -43.5, 0.04, OBSERVED, 10.0, 15.0, BOX),
-    })
+def test_bayes_factors_against_the_first_law_or_the_named_one():
+    results = {"johnson-cook": ModelResult(("A", "B"), -45.0, 0.03, OBSERVED, 12.0, 20.0, BOX),
+               "steinberg-guinan": ModelResult(("Y0_GPa", "n", "V1"), -43.5, 0.04, OBSERVED, 10.0, 15.0, BOX)}
+    against_sg = evidence_table(results, "steinberg-guinan").set_index("model")
+    assert against_sg.loc["johnson-cook", "log_bf_vs_reference"] == pytest.approx(-1.5)
+    assert set(against_sg["reference_model"]) == {"steinberg-guinan"} and against_sg.loc["steinberg-guinan", "log_bf_sd"] == 0
+    table = evidence_table(results)
     assert list(table.columns) == COLUMNS
     sg = table.set_index("model").loc["steinberg-guinan"]
-    assert sg["log_bf_vs_johnson_cook"] == pytest.approx(1.5)
+    assert sg["log_bf_vs_reference"] == pytest.approx(1.5) and sg["reference_model"] == "johnson-cook"
     assert sg["log_bf_sd"] == pytest.approx(0.05)                       # 0.03 and 0.04 in quadrature
     assert sg["n_params"] == 3
-    assert table.set_index("model").loc["johnson-cook", "log_bf_vs_johnson_cook"] == 0.0
+    assert table.set_index("model").loc["johnson-cook", "log_bf_vs_reference"] == 0.0
     assert (sg["n_box_params"], sg["log_z_box_half"], sg["log_z_box_half_sd"], sg["log_z_box_double"],
             sg["posterior_mass_near_faces"]) == tuple(BOX)
 
@@ -38,8 +40,8 @@ def test_evidences_of_other_data_do_not_compare():
     with pytest.raises(InputError, match="ptw was calibrated on other measured features"):
         evidence_table({"johnson-cook": ModelResult(("A",), -45.0, 0.03, OBSERVED, 12.0, 20.0, BOX),
                         "ptw": ModelResult(("s0",), -40.0, 0.03, (*OBSERVED[:3], 187.0), 12.0, 20.0, BOX)})
-    with pytest.raises(InputError, match="no johnson-cook study"):
-        evidence_table({"ptw": ModelResult(("s0",), -40.0, 0.03, OBSERVED, 12.0, 20.0, BOX)})
+    with pytest.raises(InputError, match="the reference law johnson-cook is not among the laws given \\(ptw\\)"):
+        evidence_table({"ptw": ModelResult(("s0",), -40.0, 0.03, OBSERVED, 12.0, 20.0, BOX)}, "johnson-cook")
 
 
 def _study(tmp_path, name, log_z, sd, kfold, outer=None):
@@ -86,7 +88,7 @@ def test_command_reads_each_study(tmp_path, capsys, caplog):
         0.1**2 * 0.4**2 + 0.4**2 * 0.6**2 + 0.2**2 * 0.4**2 + 0.3**2 * 0.4**2) / 0.4))
     assert za_row["log_z_box_double"] == pytest.approx(-47.0 - math.log(3 / 2))   # [0, 2] -> [0, 3]: clipped at 0
     assert za_row["posterior_mass_near_faces"] == pytest.approx(0.3)               # a = 1.95 > 1.9; 0.05 is near a face at its floor
-    assert table.loc["zerilli-armstrong", "log_bf_vs_johnson_cook"] == pytest.approx(-2.0)
+    assert table.loc["zerilli-armstrong", "log_bf_vs_reference"] == pytest.approx(-2.0)
     assert table.loc["zerilli-armstrong", "kfold_rmse_m_s"] == 11.0
     assert table.loc["zerilli-armstrong", "log_bf_sd"] == pytest.approx(math.hypot(0.03, 0.04))
     assert math.isnan(table.loc["ptw", "outer_rmse_m_s"]) and "ptw" in caplog.text and "no outer check" in caplog.text

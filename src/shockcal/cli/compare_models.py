@@ -7,6 +7,7 @@ sampler's weighted draws, for the box sensitivity), RESULTS_DIR/emulator/emulato
 RMSE over all shots and features; the outer one empty when the emulator skipped it) and, when the study
 made it, RESULTS_DIR/report/emulator_heldout.csv (the emulator on the posterior's predictive runs, which no
 fit saw: RMSE and 90% band coverage over all of them; empty columns without it).
+The Bayes factors are against `--reference` (default: the first `--model`).
 Writes `--out` (CSV; shockcal.campaign.model_comparison.COLUMNS) and, with `--figures-dir`, the log evidence per law
 (evidence.png and .pdf).
 
@@ -26,10 +27,12 @@ shockcal compare-models --model johnson-cook=results/models/johnson-cook \\
 
 def register(subparsers) -> None:
     p = add_command(subparsers, "compare-models", example=EXAMPLE_COMPARE_MODELS,
-                    help="the strength laws' log evidence and Bayes factors vs Johnson-Cook",
+                    help="the strength laws' log evidence and Bayes factors against a reference law",
                     description=__doc__)
     p.add_argument("--model", action="append", required=True, metavar="NAME=RESULTS_DIR",
-                   help="a law and its study's results_dir (repeat; johnson-cook required)")
+                   help="a law and its study's results_dir (repeat; the first is the reference unless --reference)")
+    p.add_argument("--reference", default=None, metavar="NAME",
+                   help="the law the Bayes factors are against (one of the --model names; default: the first)")
     p.add_argument("--out", required=True, help="the table (CSV), e.g. results/models/evidence.csv")
     p.add_argument("--figures-dir", default=None, help="where evidence.png and .pdf go (log Z per law with +-2 sd and "
                    "the box-halved and -doubled values), e.g. results/models/figures")
@@ -138,7 +141,7 @@ def run(args) -> int:
     from shockcal.cli import parse_model_dirs
 
     results = {law: model_result(law, results_dir) for law, results_dir in parse_model_dirs(args.model).items()}
-    table = evidence_table(results)
+    table = evidence_table(results, args.reference)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     table.to_csv(out, index=False, float_format="%.6g")
