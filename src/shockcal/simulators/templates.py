@@ -26,6 +26,7 @@ from pathlib import Path
 from shockcal.design.tables import ShotMapping
 from shockcal.errors import ConfigError
 from shockcal.hydro import Geometry, HydroSettings, MaterialProperties
+from shockcal.hydro.laws import get_law
 
 _JOHNSON_COOK = {"A_MPa": "MPa", "B_MPa": "MPa", "A_Mbar": "Mbar", "B_Mbar": "Mbar", "C": "-", "n": "-", "m": "-"}
 _SHOT = {"run": "id", "shot": "name", "velocity_m_s": "m/s", "velocity_cm_us": "cm/us", "flyer_mm": "mm",
@@ -43,7 +44,7 @@ def _unit(name: str) -> str:
 def placeholder_units(mapping: ShotMapping) -> dict[str, str]:
     """Every placeholder a run of a shot read by `mapping` has, name -> unit ("-" dimensionless)."""
     names = dict(_SHOT)
-    if mapping.model == "johnson-cook":
+    if get_law(mapping.model).code_unit_columns:     # Johnson-Cook: its MPa names and its design's Mbar ones
         names.update(_JOHNSON_COOK)
     else:
         names.update({name: _unit(name) for name in mapping.strength_inputs})
@@ -64,7 +65,7 @@ def run_values(mapping: ShotMapping, row: Mapping, geometry: Geometry, material:
                                         else geometry.initial_temperature_K),
               **material.model_dump(), **settings.model_dump()}
     values["velocity_cm_us"] = float(row[mapping.velocity_input])
-    if mapping.model == "johnson-cook":
+    if get_law(mapping.model).code_unit_columns:
         exact = params.table_iv()
         values.update(A_MPa=params.A_MPa, B_MPa=params.B_MPa, A_Mbar=exact.A_Mbar, B_Mbar=exact.B_Mbar, C=exact.C,
                       n=exact.n, m=exact.m, shear_modulus_Mbar=exact.shear_modulus_Mbar)
