@@ -28,7 +28,12 @@ does not fall as the plastic rate grows). At d = 0 the plastic rate is 0, where 
 return's increment r <= 0. The root is bracketed there and found by Newton steps in ln d, where the rate
 terms are close to linear, the slope of Y a secant through the last two iterates (a law need not supply
 one); a step that leaves the bracket is replaced by a bisection (in ln d once the bracket's lower end is
-positive). It stops when a step would move d by at most RELATIVE_TOLERANCE of d, or after MAX_ITERATIONS.
+positive). A Newton step inside the bracket that moves ln d by at most LAST_STEP is the last: its d is returned
+with Y to first order (Y + slope x step, no further evaluation of the law; the neglected terms are of order
+step^2 and (slope error) x step: at most 7e-16 of the law's Y at the returned d over tests/test_rate_return.py's
+PTW cells), which saves the evaluations that converged a step of 1e-8 to 1e-14 (docs/hydro.md, "Speed"). A
+bisection step is never the
+last: it stops when a step would move d by at most RELATIVE_TOLERANCE of d, or after MAX_ITERATIONS.
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ from numba.extending import overload
 from shockcal.hydro.laws.kernels import declared_law, law_flow_stress_cached
 
 RELATIVE_TOLERANCE = 1e-14
+LAST_STEP = 1e-8          # a Newton step in ln d this small is the last (module docstring)
 MAX_ITERATIONS = 60
 
 
@@ -73,11 +79,12 @@ def bracketed_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, ep
             lo = d_prev
         else:
             hi = d_prev
-        d = d_prev * math.exp(r / (three_G * d_prev + slope_warm))       # Newton in ln d, the remembered slope
+        step = r / (three_G * d_prev + slope_warm)                       # Newton in ln d, the remembered slope
+        d = d_prev * math.exp(step)
+        if lo < d < hi and abs(step) <= LAST_STEP:                       # the warm start's step is the last
+            return d, Y_prev + slope_warm * step, slope_warm, d / dt
         if not lo < d < hi:
             d = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
-        if abs(d - d_prev) <= RELATIVE_TOLERANCE * d_prev:             # the warm start is the solution
-            return d_prev, Y_prev, slope_warm, rate_warm
     elif Y_prev <= rate_free:    # the flow stress did not rise over the bracket: the rate-free return
         return d_prev, rate_free, slope_warm, rate_warm
     else:
@@ -94,7 +101,10 @@ def bracketed_plastic_increment_warm(law, equivalent, rate_free, G, dt, hard, ep
             lo = d
         else:
             hi = d
-        candidate = d * math.exp(r / (three_G * d + secant))    # Newton in ln d: dr / d ln d = -(3 G d + secant)
+        step = r / (three_G * d + secant)                       # Newton in ln d: dr / d ln d = -(3 G d + secant)
+        candidate = d * math.exp(step)
+        if lo < candidate < hi and abs(step) <= LAST_STEP:      # the last step: Y to first order, no evaluation
+            return candidate, Y + secant * step, secant, candidate / dt
         if not lo < candidate < hi:
             candidate = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
         if abs(candidate - d) <= RELATIVE_TOLERANCE * d:
