@@ -1,9 +1,11 @@
 """A hydrocode change against another source tree (issue 62): printed, never asserted (docs/journal/hydro.md).
 
     python benchmarks/rate_return_compare.py --before ../main/src --rows 6 --inputs A C n V G1 [--mesh 8 4 2]
-        [--flag 40] [--speed]
+        [--flag 40] [--speed] [--model ptw]
 
-Runs the same design rows of the paper's design (../shared/data/al5083/design.csv, Table IV units) twice,
+Runs the same design rows of the paper's design (../shared/data/al5083/design.csv, Table IV units; with
+`--model` another strength law, rows of a Latin hypercube of that law's box, seed 0: config/config.yaml with
+`strength.model` set, the law's box from config/models.yaml; the MPa door and FLAG are Johnson-Cook's) twice,
 once with each source tree (`--before`, e.g. a `git worktree` of main's src, and this tree's src), each in a
 subprocess of its own (PYTHONPATH), and prints side by side:
   a. rounding floor: each input the shot reads raised by one part in 1e12 (`--inputs`), per feature the
@@ -66,14 +68,26 @@ def _window_change(base, other, features, window_us):
     return float(np.max(change[inside])), float(np.max(change[flat]))
 
 
+def _study(model: str | None):
+    """(the validated config, the design): the paper's config and design, or with `model` the config under that
+    law and a seeded Latin hypercube of its box (a row per run; --rows of them are run)."""
+    from shockcal.design.tables import latin_hypercube
+    from shockcal.study.config import prior_bounds
+    from shockcal.study.config_files import merge_config_files, merge_into
+    from shockcal.study.validate import load_config, validate_config
+
+    if model is None:
+        return load_config(CONFIG), pd.read_csv(DESIGN)
+    config = validate_config(merge_into(merge_config_files([CONFIG])[0], {"strength": {"model": model}}))
+    return config, latin_hypercube(prior_bounds(config), 200, seed=0)
+
+
 def child(args) -> None:
     from shockcal.hydro import ShotParameters, run_shot
     from shockcal.study.adapters import extractor_settings, hydro_inputs, shot_mapping
     from shockcal.study.config import shot_config
-    from shockcal.study.validate import load_config
 
-    config = load_config(CONFIG)
-    design = pd.read_csv(DESIGN)
+    config, design = _study(args.model)
     rows = []
 
     def add(shot, run, variant, result, settings, **extra):
@@ -100,9 +114,10 @@ def child(args) -> None:
             halved = run_shot(params, inputs[0], inputs[1], inputs[2].replace(cfl=inputs[2].cfl / 2))
             everywhere, off_fronts = _window_change(base, halved, f, window)
             add(shot, run, "cfl_half", halved, settings, window_change=everywhere, window_change_off_fronts=off_fronts)
-            mpa = ShotParameters(params.A_MPa, params.B_MPa, params.C, params.n, params.m, params.velocity_m_s,
-                                 params.shear_modulus_GPa)
-            add(shot, run, "mpa_door", run_shot(mpa, *inputs), settings)
+            if isinstance(params, ShotParameters):      # Johnson-Cook's two doors
+                mpa = ShotParameters(params.A_MPa, params.B_MPa, params.C, params.n, params.m, params.velocity_m_s,
+                                     params.shear_modulus_GPa)
+                add(shot, run, "mpa_door", run_shot(mpa, *inputs), settings)
             for cell_um in args.mesh:
                 mesh_config = json.loads(json.dumps(config))
                 mesh_config["hydro"]["cell_size_um"] = cell_um
@@ -173,7 +188,12 @@ def report(before: dict, after: dict, args) -> None:
                                                                   "off the fronts": rows.window_change_off_fronts.max()})])})
     print_side_by_side(f"b. time step: CFL 0.25 against 0.5, max |change| ({runs}; m/s, times ns)", cfl(b), cfl(a))
     door = lambda rows: pd.DataFrame({"max": changes(rows, "mpa_door")[FEATURES].max()})  # noqa: E731
-    print_side_by_side(f"c. MPa door against the Mbar door, max |change| ({runs}; m/s, times ns)", door(b), door(a))
+    if args.model is None:
+        print_side_by_side(f"c. MPa door against the Mbar door, max |change| ({runs}; m/s, times ns)", door(b), door(a))
+    same = lambda rows: rows[rows.variant == "base"].set_index(["shot", "run"])  # noqa: E731
+    moved = (_scaled(same(a), FEATURES) - _scaled(same(b), FEATURES)).abs()
+    print(f"\ng. the same runs in the two trees: |after - before| ({runs}; m/s, times ns)")
+    print(pd.DataFrame({"median": moved.median(), "max": moved.max()}).to_string(float_format=lambda x: f"{x:.3g}"))
     if before["speed"]:
         print("\nd. speed: a 104S run (design row 0), CPU seconds, best of 3")
         print(f"   before {before['speed']['cpu_s']:.2f} s (load {before['speed']['load']:.1f})   "
@@ -207,6 +227,7 @@ def parse_args(argv):
     parser.add_argument("--mesh", nargs="*", type=float, default=[], help="cell sizes (um) for e, e.g. 8 4 2")
     parser.add_argument("--flag", type=int, default=0, help="design runs 0..N-1 against FLAG (f)")
     parser.add_argument("--speed", action="store_true", help="d: time a 104S run in each tree")
+    parser.add_argument("--model", default=None, help="another strength law (its box's hypercube rows; no c, no f)")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--out", type=Path, help=argparse.SUPPRESS)
     return parser.parse_args(argv)
@@ -221,7 +242,8 @@ def main(argv=None) -> None:
     if args.before is None:
         sys.exit("rate_return_compare.py: --before: give the source tree to compare with (its src/)")
     passed = ["--rows", str(args.rows), "--shots", *args.shots, "--inputs", *args.inputs, "--flag", str(args.flag),
-              *(["--mesh", *map(str, args.mesh)] if args.mesh else []), *(["--speed"] if args.speed else [])]
+              *(["--mesh", *map(str, args.mesh)] if args.mesh else []), *(["--speed"] if args.speed else []),
+              *(["--model", args.model] if args.model else [])]
     print(f"load average at start: {os.getloadavg()[0]:.2f}", flush=True)
     before = run_tree(args.before, passed, "before")
     after = run_tree(ROOT / "src", passed, "after")
