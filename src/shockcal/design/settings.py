@@ -15,21 +15,27 @@ from shockcal.errors import number
 from shockcal.settings_model import SettingsError, SettingsModel, setting
 
 
-class InputRange(SettingsModel):
-    """One calibrated input's uniform prior box: the study config's `inputs.<name>` (paper Table IV), checked on
-    creation (a SettingsError naming the field) and by `InputBox` for each of its inputs."""
+class Bounds(SettingsModel):
+    """A uniform prior box's ends: a strength law's parameter's (`strength.inputs.<name>`, in the unit its name
+    carries) and, with its unit, a calibrated input's (`InputRange`). Checked on creation: min below max."""
 
-    min: float = setting(..., "Lower bound of the box (below `max`).", unit="the input's `unit`")
-    max: float = setting(..., "Upper bound of the box.", unit="the input's `unit`")
-    unit: str = setting(..., "Unit of the bounds and of the input's design and posterior columns, written into the "
-                             "tables' metadata (`Mbar`, `cm/us`, or `-` when dimensionless).")
+    min: float = setting(..., "Lower bound of the box (below `max`).", unit="the input's unit")
+    max: float = setting(..., "Upper bound of the box.", unit="the input's unit")
 
     @model_validator(mode="after")
     def _ordered(self):
         if not self.min < self.max:
             reason = f"{number(self.min)} is not below max ({number(self.max)})"
-            raise SettingsError(f"InputRange.min: {reason}", "min", reason)
+            raise SettingsError(f"{type(self).__name__}.min: {reason}", "min", reason)
         return self
+
+
+class InputRange(Bounds):
+    """One calibrated input's uniform prior box: the study config's `inputs.<name>` (paper Table IV), checked on
+    creation (a SettingsError naming the field) and by `InputBox` for each of its inputs."""
+
+    unit: str = setting(..., "Unit of the bounds and of the input's design and posterior columns, written into the "
+                             "tables' metadata (`Mbar`, `cm/us`, or `-` when dimensionless).")
 
 
 class DesignSettings(SettingsModel):

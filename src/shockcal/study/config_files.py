@@ -28,7 +28,7 @@ from shockcal.campaign.settings import (
     NextShotSettings,
     SensitivitySettings,
 )
-from shockcal.design.settings import DesignSettings, InputRange, NewShotSettings, WaveSettings
+from shockcal.design.settings import Bounds, DesignSettings, InputRange, NewShotSettings, WaveSettings
 from shockcal.emulator.settings import EmulatorSettings
 from shockcal.errors import ConfigError
 from shockcal.hydro.laws.settings import StrengthSettings
@@ -60,7 +60,8 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # field of another section (`setting(section=...)`: ExtractorSettings' analysis window) is generated there. A
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
 MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots.*": Plates, "inputs.*": InputRange,
-                  "emulator": EmulatorSettings, "features": ExtractorSettings, "calibration": SamplerSettings,
+                  "strength.inputs.*": Bounds, "emulator": EmulatorSettings, "features": ExtractorSettings,
+                  "calibration": SamplerSettings,
                   "calibration.check": CheckSettings, "calibration.discrepancy": DiscrepancySettings,
                   "verify": VerifySettings, "design": DesignSettings, "design.new_shots": NewShotSettings,
                   "design.waves": WaveSettings, "design.waves.step_calibration": StepSamplerSettings,
