@@ -33,10 +33,10 @@ with Y to first order (Y + slope x step, no further evaluation of the law; the n
 step^2 and (slope error) x step: at most 7e-16 of the law's Y at the returned d over tests/test_rate_return.py's
 PTW cells), which saves the evaluations that converged a step of 1e-8 to 1e-14 (docs/hydro.md, "Speed"). A
 bisection step is never the last: it stops when a step would move d by at most RELATIVE_TOLERANCE of d, or
-after MAX_ITERATIONS. Until the
-bracket has a positive lower end a bisection halves d, and a root far below the bracket's top takes as many
-halvings as its binary orders of magnitude: at 60 iterations some steps of PTW runs stopped unconverged, each
-a jump (a 1e-12 change of an input moved a 104S-like run's trace by up to 0.6 m/s); at 200 none did.
+after MAX_ITERATIONS. Until the bracket has a positive lower end a bisection halves d, and a root far below the
+bracket's top takes as many halvings as its binary orders of magnitude: at 60 iterations some steps of PTW runs
+stopped unconverged, each a jump (a 1e-12 change of an input moved a 104S-like run's trace by up to 0.6 m/s); at
+200 none did (48 perturbed runs, docs/hydro.md).
 """
 
 from __future__ import annotations

@@ -61,8 +61,8 @@ FILL_IN = "<fill in>"     # the placeholder `shockcal init` writes for a value t
 # section that is a mapping or a word (`calibration.discrepancy`: none) gets the keys of its mapping form.
 MODEL_SECTIONS = {"material": MaterialProperties, "hydro": HydroSettings, "shots.*": Plates, "inputs.*": InputRange,
                   "strength.inputs.*": Bounds, "emulator": EmulatorSettings, "features": ExtractorSettings,
-                  "calibration": SamplerSettings,
-                  "calibration.check": CheckSettings, "calibration.discrepancy": DiscrepancySettings,
+                  "calibration": SamplerSettings, "calibration.check": CheckSettings,
+                  "calibration.discrepancy": DiscrepancySettings,
                   "verify": VerifySettings, "design": DesignSettings, "design.new_shots": NewShotSettings,
                   "design.waves": WaveSettings, "design.waves.step_calibration": StepSamplerSettings,
                   "checks": ChecksSettings, "simulate": SimulateSettings, "predict": PredictSettings,
