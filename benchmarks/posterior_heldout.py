@@ -7,7 +7,8 @@ calibration uses the emulator, and a K-fold on a design crowded into the posteri
 (docs/sequential.md). Optionally a second results directory's emulator predicts the same runs (e.g. the
 paper design's 1000-run emulator on the sequential study's posterior runs).
 
-    python benchmarks/posterior_heldout.py --results results/sequential [--other-emulator results/emulator]
+    python benchmarks/posterior_heldout.py --results results/sequential [--other-emulator results/emulator] \
+        [--run-set verify]      # the draws `make verify` ran instead of the predictive runs
 """
 
 from __future__ import annotations
@@ -24,14 +25,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, required=True, help="a study's results directory")
     parser.add_argument("--other-emulator", type=Path, help="another emulator directory to score on the same runs")
+    parser.add_argument("--run-set", default="predict", help="the run set of posterior draws (predict, or verify)")
     args = parser.parse_args()
-    design = pd.read_parquet(args.results / "predict" / "design.parquet")
-    shots = sorted(p.stem for p in (args.results / "predict" / "features").glob("*.parquet"))
-    features = {s: pd.read_parquet(args.results / "predict" / "features" / f"{s}.parquet") for s in shots}
+    runs = args.results / args.run_set
+    design = pd.read_parquet(runs / "design.parquet")
+    shots = sorted(p.stem for p in (runs / "features").glob("*.parquet"))
+    features = {s: pd.read_parquet(runs / "features" / f"{s}.parquet") for s in shots}
     for label, directory in [("study emulator", args.results / "emulator"), ("other emulator", args.other_emulator)]:
         if directory is None:
             continue
-        print(f"{label} {directory} on {args.results / 'predict'}:")
+        print(f"{label} {directory} on {runs}:")
         emulator = Emulator.load(directory)
         print(score_heldout(emulator, design, features).to_string(index=False, float_format="%.3f"))
         print("the error model's 90% region of each block's feature vector:")

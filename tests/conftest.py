@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from shockcal.reference import reference_dir
+from shockcal.study.read_log import READ_LOG
 from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -49,10 +50,10 @@ class BackgroundStudy:
         self.results, self.overlay, self.log = root / "results", root / "results.yaml", root / "snakemake.log"
         self.overlay.write_text(yaml.safe_dump({"study": {"results_dir": str(self.results)}}))
         snakemake = str(Path(sys.executable).parent / "snakemake")
-        with self.log.open("w") as log:
+        with self.log.open("w") as log:  # each command logs the keys of its config slice that it reads
             self.process = subprocess.Popen([snakemake, "all", "--cores", "2", "--configfile", "config/quick.yaml",
                                              str(self.overlay)], cwd=REPO, stdout=log, stderr=subprocess.STDOUT,
-                                            start_new_session=True)
+                                            start_new_session=True, env={**os.environ, READ_LOG: str(read_log(root))})
 
     def wait(self) -> tuple[Path, Path]:
         """(the results directory, the config overlay naming it) once the study has finished; the test
@@ -69,6 +70,18 @@ class BackgroundStudy:
 
 
 QUICK_STUDY = pytest.StashKey[BackgroundStudy]()
+
+
+def read_log(root: Path) -> Path:
+    """The folder where the quick study's commands log which keys of their config slices they read
+    (`shockcal.study.read_log`), beside its results."""
+    return root / "reads"
+
+
+@pytest.fixture(scope="session")
+def quick_study_reads(quick_study) -> Path:
+    """The finished quick study's read log: one JSON file per command (`shockcal.study.read_log`)."""
+    return read_log(quick_study[0].parent)
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -118,3 +118,16 @@ def test_the_calibrations_read_the_discrepancy_from_their_slice(tmp_path, stage,
     assert settings.discrepancy == DiscrepancySettings(kind="feature_kind", sd_fraction_prior=0.03)
     assert calibration_settings(load_stage_config(REPO / "config" / "config.yaml", stage), ["104S"],
                                 check=check).discrepancy == "none"
+
+
+@pytest.mark.parametrize(("source", "given", "left_out"), [
+    ("records", {"records", "readout_error", "readout_replicates"}, "features"),
+    ("published", {"features"}, "records"),
+])
+def test_the_observed_stage_reads_its_sources_keys_alone(config, source, given, left_out):
+    """A change of the published values does not rerun a study measured from its records (and whatever
+    depends on its observed table), nor the other way round; the velocity boxes of the plateau check only."""
+    sliced = stage_config({**config, "observed": {**config["observed"], "source": source}}, "observed")
+    assert given <= set(sliced["observed"]) and left_out not in sliced["observed"]
+    assert ("features" in sliced) == (source == "records")     # the extractor's settings
+    assert set(sliced["inputs"]) == {spec["velocity_input"] for spec in config["shots"].values()}

@@ -77,6 +77,26 @@ def study(quick_study):
     return quick_study
 
 
+def test_every_declared_key_is_read_by_its_jobs(study, quick_study_reads):
+    """A stage's declared keys are its rule's params (a change reruns it): each is read by a job of the stage
+    (over its jobs: one job reads one shot's keys) or it reruns jobs for nothing. Each command of the quick
+    study logged the keys of its slice it read (shockcal.study.read_log); a figure is its own stage."""
+    import json
+
+    declared: dict[str, set] = {}
+    read: dict[str, set] = {}
+    for log in quick_study_reads.glob("*.json"):
+        entry = json.loads(log.read_text())
+        declared.setdefault(entry["stage"], set()).update(entry["declared"])
+        read.setdefault(entry["stage"], set()).update(entry["reads"])
+    unread = {stage: sorted(keys - read[stage]) for stage, keys in declared.items() if keys - read[stage]}
+    assert not unread, f"declared and never read (stage: keys): {unread}"
+    commands = {stage for stage in declared if not stage.startswith("figure ")}
+    assert {"simulate", "features", "observed", "emulate", "calibrate", "predict", "sensitivity"} <= commands
+    made = [spec for spec in catalogue(load_config("config/quick.yaml")).values() if spec.target == "all"]
+    assert len(declared) - len(commands) == len(made)      # every figure of the study
+
+
 def test_every_figure_is_a_real_image(study):
     results, _ = study
     config = load_config(REPO / "config" / "config.yaml")

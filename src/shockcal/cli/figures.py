@@ -41,6 +41,7 @@ def run(args) -> int:
     from shockcal.errors import InputError
     from shockcal.plots.style import save_figure
     from shockcal.study.figure_catalogue import FigureInputs, catalogue, figure_spec
+    from shockcal.study.read_log import recorded
     from shockcal.study.stages import figure_config
     from shockcal.study.validate import load_config
 
@@ -52,7 +53,7 @@ def run(args) -> int:
     if not args.figure:
         raise InputError("give --figure NAME (or --list)")
     spec = figure_spec(args.figure, config)
-    config = figure_config(config, args.figure)  # the figure's code sees only the keys it declares
+    config = recorded(figure_config(config, args.figure), f"figure {args.figure}")  # only the keys it declares
     fig = spec.build(FigureInputs(parse_inputs(args.input)), config)
     paths = save_figure(fig, Path(args.out_dir) / args.figure, config["figures"]["formats"], config["figures"]["dpi"])
     logging.getLogger("shockcal.figures").info("wrote %s", ", ".join(map(str, paths)))

@@ -32,9 +32,9 @@ UNIT_SUFFIXES = (("_J_per_kg_K", "J/(kg K)"), ("_per_s", "1/s"), ("_per_K", "1/K
                  ("_g_per_mol", "g/mol"), ("_Mbar", "Mbar"), ("_mm", "mm"), ("_um", "um"), ("_us", "us"), ("_ns", "ns"),
                  ("_K", "K"))
 # STAGE_KEYS path segments that stand for any key, and what they say about which jobs rerun
-WILDCARDS = {"*": "", "{shot}": "its shot", "{shot_inputs}": "shots that read it"}
-# the figure catalogue lists the figures of a config's shots: three stand-ins give every figure
-FIGURE_SHOTS = {"shots": {"S1": {}, "S2": {}, "S3": {}}, "observed": {"records": {}}}
+WILDCARDS = {"*": "", "{shot}": "its shot", "{shot_inputs}": "shots that read it", "{names}": ""}
+# the figure catalogue lists the figures of a config's shots: three stand-ins, each with a record, give every figure
+FIGURE_SHOTS = {"shots": {"S1": {}, "S2": {}, "S3": {}}, "observed": {"records": {"S1": {}, "S2": {}, "S3": {}}}}
 
 HEADER = """\
 # Configuration reference
@@ -89,10 +89,10 @@ def undescribed(schema: dict) -> list[str]:
 def reruns(path: tuple[str, ...], stage_keys: dict[str, tuple[str, ...]] | None = None,
            figure_reads: dict[str, tuple[str, ...]] | None = None) -> str:
     """Which stages (and figures) a change of the key at `path` reruns, from `stage_keys` (default
-    `STAGE_KEYS`) and the figures' `reads` (default: the catalogue's), as the page writes it."""
-    from shockcal.study.stages import STAGE_KEYS
+    `documented_stage_keys()`) and the figures' `reads` (default: the catalogue's), as the page writes it."""
+    from shockcal.study.stages import documented_stage_keys
 
-    stage_keys = STAGE_KEYS if stage_keys is None else stage_keys
+    stage_keys = documented_stage_keys() if stage_keys is None else stage_keys
     figure_reads = _figure_reads() if figure_reads is None else figure_reads
     parts = []
     for stage, declared in stage_keys.items():
@@ -164,6 +164,8 @@ def _overlaps(path: tuple[str, ...], declared: list[str]) -> bool:
     """Whether a key path and a declared path (STAGE_KEYS syntax) share a key: one is the other's prefix,
     segment by segment, a placeholder or wildcard matching any key; an optional key's `?` is dropped."""
     declared = [*declared[:-1], declared[-1].removesuffix("?")] if declared else declared
+    if declared and declared[-1] == "{names}" and len(path) > len(declared):
+        return False            # the names alone: a key inside one is not read
     return all(k.removesuffix("[]") == d or d in WILDCARDS or k.startswith("<") for k, d in zip(path, declared))
 
 

@@ -208,10 +208,14 @@ def history_names(config) -> dict[str, str]:
 
 # what the builders read: the shots (names, analysis windows), the records' columns, the extractor's
 # settings, the prior box and the reference sets of its law, the observation error, the figures' random stream
-_RECORDS = ("shots", "observed.records")
-_TRACE = (*_RECORDS, "features")
-_POSTERIOR = ("shots", "inputs", "strength.model?", "study.reference_sets?")
-_FEATURE_SPACE = ("shots", "observed.sd_fraction")
+_SHOT_NAMES = ("shots.{names}",)
+_POSTERIOR = ("shots.*.shear_modulus_inputs", "inputs", "strength.model?", "study.reference_sets?")
+_FEATURE_SPACE = (*_SHOT_NAMES, "observed.sd_fraction")
+
+
+def _record_columns(shot: str) -> tuple[str, ...]:
+    """A shot's record's columns (the record itself is the figure's input file), when the shot has one."""
+    return tuple(f"observed.records.{shot}.{column}?" for column in ("time_column", "velocity_column"))
 
 
 def catalogue(config) -> dict[str, FigureSpec]:
@@ -225,6 +229,7 @@ def catalogue(config) -> dict[str, FigureSpec]:
 
     # Figs 4, 5, 15 draw one trace: the first shot's record when configured, else one of its runs
     trace = per("record" if shots[0] in recorded else "sample_simulations", shots[:1])
+    trace_reads = (*_SHOT_NAMES, f"shots.{shots[0]}.analysis", *_record_columns(shots[0]), "features")
     features = per("features", shots)
 
     def history(shot):
@@ -233,25 +238,27 @@ def catalogue(config) -> dict[str, FigureSpec]:
 
     specs = [
         FigureSpec("fig01_toy_calibration", "1 method", partial(_toy, "fig01_toy_calibration")),
-        FigureSpec("fig02_records", "2 data", _records, _RECORDS, ("observed", *per("record", recorded))),
+        FigureSpec("fig02_records", "2 data", _records, (*_SHOT_NAMES, *(c for s in recorded for c in _record_columns(s))),
+                   ("observed", *per("record", recorded))),
         FigureSpec("fig03_gp_draws", "1 method", partial(_toy, "fig03_gp_draws")),
-        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features"), _TRACE, trace),
-        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split"), _TRACE, trace),
-        FigureSpec("fig06_crossval", "3 emulator", _crossval, ("shots",), ("cv",)),
+        FigureSpec("fig04_trace_features", "2 data", partial(_trace_figure, "fig04_trace_features"), trace_reads, trace),
+        FigureSpec("fig05_mixture_split", "1 method", partial(_trace_figure, "fig05_mixture_split"), trace_reads, trace),
+        FigureSpec("fig06_crossval", "3 emulator", _crossval, _SHOT_NAMES, ("cv",)),
         FigureSpec("fig07_marginals", "4 posterior", _marginals, _POSTERIOR, per("posterior", [*shots, "joint"])),
         FigureSpec("fig08_pairs", "4 posterior", _pairs, _POSTERIOR, ("posterior:joint",)),
         FigureSpec("fig09_features_emulator", "5 posterior predictions", _features_emulator, _FEATURE_SPACE,
                    (*features, "observed", "emulator_predictions")),
         FigureSpec("fig10_features_hydrocode", "5 posterior predictions", _features_hydrocode, _FEATURE_SPACE,
                    (*features, "observed", *per("predicted_features", shots))),
-        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot), (*_RECORDS, "study.seed"),
+        *(FigureSpec(name, "5 posterior predictions", partial(_history, shot),
+                     (*_record_columns(shot), "study.seed"),
                      history(shot))
           for name, shot in history_names(config).items()),
         FigureSpec("fig14_inadequate_model", "1 method", partial(_toy, "fig14_inadequate_model")),
-        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), _TRACE,
+        FigureSpec("fig15_pit_construction", "1 method", partial(_trace_figure, "fig15_pit_construction"), trace_reads,
                    trace),
         # beyond the paper
-        FigureSpec("sobol_indices", "6 sensitivity", _sobol, ("shots",), ("sobol",)),
+        FigureSpec("sobol_indices", "6 sensitivity", _sobol, _SHOT_NAMES, ("sobol",)),
         FigureSpec("features_vs_training", "2 data", _measured_against_training, _FEATURE_SPACE,
                    (*features, "observed")),
         # which shot next (`make next-shot`), when the config has candidates

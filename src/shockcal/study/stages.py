@@ -10,7 +10,9 @@ serves both channels a stage gets its settings through:
   the tests) instead of silently missing from the rerun triggers.
 
 Path segments: a key; `*` every key at that level (e.g. every shot); `{shot}` the shot the job
-works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`). A trailing `?`
+works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`); `{names}`, last,
+the names of the section's keys alone (`shots.{names}`: which shots, each an empty section, for a job
+that reads no shot's settings). A trailing `?`
 marks an optional key, sliced only when the config gives it: a key whose absence is its default (a
 shot's `initial_temperature_K`), so that declaring it reruns none of the jobs of configs without it.
 """
@@ -24,8 +26,11 @@ from shockcal.inference.settings import SamplerSettings
 from shockcal.settings_model import KEY, OPTIONAL, SECTION, SettingsModel, schema_extras
 from shockcal.study.adapters import shot_mapping
 from shockcal.study.config import shot_config
+from shockcal.study.read_log import recorded
 from shockcal.study.strength_config import strength_law, strength_model
 from shockcal.study.validate import load_config
+
+NAMES = "{names}"
 
 
 def model_keys(model: type[SettingsModel], section: str, optional: bool = True) -> tuple[str, ...]:
@@ -76,9 +81,8 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # the failed-run budget where a shot's features are merged
     "failure_budget": ("simulate.max_failed_fraction", "shots.{shot}.analysis"),
     # the measured features of every shot (from the records or the published values)
-    "observed": ("study.seed", "observed.source", "observed.features", "observed.records", "observed.readout_error",
-                 "observed.readout_replicates", "features", "shots.*.analysis",
-                 "checks.observed_units", "checks.plateau_vs_velocity", "inputs", "shots.*.velocity_input"),
+    # (with the keys of its source, `_observed_keys`)
+    "observed": ("observed.source", "checks.plateau_vs_velocity", "shots.*.velocity_input"),
     # the emulator fit and its cross-validation
     "emulate": ("study.seed", "emulator", "inputs", "checks.design_box", "material.T_ref_K", *_SHOT_MAPPING),
     # the emulator's predictions at a design's runs
@@ -100,9 +104,9 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # every run of a sequential study so far, one design and one features table per shot
     "merge_runs": ("inputs", "checks.design_box", *_SHOT_MAPPING),
     # the posterior rows run through the hydrocode for predictions
-    "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.*.velocity_input"),
+    "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.{names}"),
     # the hydrocode's verdict (`make verify`): its posterior draws, and their PSIS against the emulator's likelihood
-    "verify_design": ("study.seed", "verify.n_draws", "inputs", "shots.*.velocity_input"),
+    "verify_design": ("study.seed", "verify.n_draws", "inputs", "shots.{names}"),
     "verify": ("verify.n_draws", "calibration.discrepancy", "observed.sd_fraction", "inputs", "checks.design_box",
                *_SHOT_MAPPING),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
@@ -135,6 +139,7 @@ def stage_config(config: dict, stages: str | Iterable[str], shot: str | None = N
     if unknown:
         raise ValueError(f"unknown stage {unknown[0]!r}; stages: {', '.join(STAGE_KEYS)}")
     paths = [path for stage in stages for path in STAGE_KEYS[stage]] + _law_material_keys(config, stages)
+    paths += _observed_keys(config) if "observed" in stages else []
     sliced = config_slice(config, paths, shot, "+".join(stages))
     if "emulate" in stages:
         _drop_unread_yield_input(config, stages, sliced)
@@ -154,6 +159,27 @@ def _law_material_keys(config: dict, stages: list[str]) -> list[str]:
         return []
     return [f"material.{p.material}" for p in law.params
             if p.material is not None and p.name not in config["inputs"]]
+
+
+# what the observed stage reads of its source (`observed.source`, `adapters.observed_table`): the records through
+# the extractor with their read-out noise, or the published values
+_OBSERVED_SOURCE = {"records": ("study.seed", "observed.records", "observed.readout_error", "observed.readout_replicates",
+                                "features", "shots.*.analysis"),
+                    "published": ("observed.features",)}
+
+
+def _observed_keys(config: dict) -> list[str]:
+    """The observed stage's keys that depend on the config: its source's (`_OBSERVED_SOURCE`), and the boxes of
+    the shots' impact velocities, against which each plastic plateau is checked."""
+    velocities = [f"inputs.{spec['velocity_input']}?" for spec in config["shots"].values()]
+    return [*_OBSERVED_SOURCE.get(config["observed"]["source"], ()), *velocities]
+
+
+def documented_stage_keys() -> dict[str, tuple[str, ...]]:
+    """`STAGE_KEYS` with the keys a stage reads under some config (the observed stage's sources, any input a shot's
+    velocity may name): what docs/configuration.md's "reruns" column says."""
+    sources = [key for keys in _OBSERVED_SOURCE.values() for key in keys]
+    return {**STAGE_KEYS, "observed": (*STAGE_KEYS["observed"], *sources, "inputs")}
 
 
 def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> None:
@@ -183,10 +209,15 @@ def config_slice(config: dict, paths: Iterable[str], shot: str | None = None, la
     sliced: dict = {}
     for path in paths:
         optional = path.endswith("?")
-        for keys in _expand(config, path.removesuffix("?").split("."), shot, label):
+        parts = path.removesuffix("?").split(".")
+        names = parts[-1] == NAMES
+        for keys in _expand(config, parts[:-1] if names else parts, shot, label):
             if optional and not _present(config, keys):
                 continue
-            _copy(config, keys, sliced, f"{label}: {path}")
+            if names:
+                _copy_names(config, keys, sliced, f"{label}: {path}")
+            else:
+                _copy(config, keys, sliced, f"{label}: {path}")
     return sliced
 
 
@@ -196,7 +227,8 @@ def load_stage_config(path, stages: str | Iterable[str], shot: str | None = None
     config = load_config(path)
     if shot is not None and shot not in config["next_shot"]["candidates"]:
         shot_config(config, shot)
-    return stage_config(config, stages, shot)
+    label = stages if isinstance(stages, str) else "+".join(stages)
+    return recorded(stage_config(config, stages, shot), label)
 
 
 def is_candidate(path, name: str) -> bool:
@@ -239,6 +271,15 @@ def _present(config: dict, keys: list[str]) -> bool:
             return False
         node = node[key]
     return True
+
+
+def _copy_names(config: dict, keys: list[str], sliced: dict, declared: str) -> None:
+    """The names of the section at `keys`, each an empty section unless a full path gave it."""
+    target = sliced
+    for key in keys:
+        target = target.setdefault(key, {})
+    for name in _node(config, keys, declared):
+        target.setdefault(name, {})
 
 
 def _copy(config: dict, keys: list[str], sliced: dict, declared: str) -> None:
