@@ -14,7 +14,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
-from test_workflow import job_counts, overlay, pending_jobs, snakemake
+from test_workflow import job_counts, overlay, pending_jobs, snakemake, unread_keys
 
 REPO = Path(__file__).resolve().parents[1]
 SEQUENTIAL = REPO / "config" / "sequential-quick.yaml"
@@ -72,8 +72,17 @@ def sequential(tmp_path_factory):
     """The toy sequential study run once: (results directory, its config overlay)."""
     root = tmp_path_factory.mktemp("sequential")
     config = waves_overlay(root / "results.yaml", root / "results")
-    snakemake("all", "--cores", "2", config_files=[SEQUENTIAL, config])
+    snakemake("all", "--cores", "2", config_files=[SEQUENTIAL, config], read_log=root / "reads")
     return root / "results", config
+
+
+@pytest.mark.slow
+def test_the_waves_stages_read_every_key_they_declare(sequential):
+    """The stages only a sequential study runs (wave designs, merged runs, the lighter step calibrations), as the
+    quick study's in test_workflow: a declared key none of their jobs read would rerun them for nothing."""
+    unread, stages = unread_keys(sequential[0].parent / "reads")
+    assert not unread, f"declared and never read (stage: keys): {unread}"
+    assert {"wave_design", "merge_runs", "emulate", "calibrate"} <= stages, stages
 
 
 @pytest.mark.slow

@@ -8,6 +8,7 @@ are dry runs against it.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
@@ -24,20 +25,23 @@ import pytest
 import yaml
 
 from shockcal.study.figure_catalogue import catalogue
+from shockcal.study.read_log import READ_LOG
 from shockcal.study.validate import load_config
 
 REPO = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).parent / "snakemake")
 
 
-def snakemake(*args, config_files=(), check=True, **popen):
+def snakemake(*args, config_files=(), check=True, read_log=None, **popen):
     """Run snakemake in the repository with config/quick.yaml plus `config_files` (targets first:
-    --configfile takes every argument after it)."""
+    --configfile takes every argument after it); with `read_log`, its commands log there the keys of their
+    config slices they read (`unread_keys`)."""
     command = [SNAKEMAKE, *args, "--configfile", "config/quick.yaml", *map(str, config_files)]
     if popen:   # Ctrl-C must reach it even when the tests run in a background job, which ignores SIGINT
         return subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL), **popen)
-    done = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
+    env = None if read_log is None else {**os.environ, READ_LOG: str(read_log)}
+    done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, env=env)
     if check and done.returncode != 0:
         pytest.fail(f"snakemake {' '.join(args)} failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
     return done
@@ -77,19 +81,22 @@ def study(quick_study):
     return quick_study
 
 
-def test_every_declared_key_is_read_by_its_jobs(study, quick_study_reads):
-    """A stage's declared keys are its rule's params (a change reruns it): each is read by a job of the stage
-    (over its jobs: one job reads one shot's keys) or it reruns jobs for nothing. Each command of the quick
-    study logged the keys of its slice it read (shockcal.study.read_log); a figure is its own stage."""
-    import json
-
+def unread_keys(folder: Path) -> tuple[dict[str, list[str]], set[str]]:
+    """From a read log (shockcal.study.read_log): the keys each stage declared that none of its jobs read (over
+    its jobs: one job reads one shot's keys), and the stages logged (a figure is a stage of its own)."""
     declared: dict[str, set] = {}
     read: dict[str, set] = {}
-    for log in quick_study_reads.glob("*.json"):
+    for log in folder.glob("*.json"):
         entry = json.loads(log.read_text())
         declared.setdefault(entry["stage"], set()).update(entry["declared"])
         read.setdefault(entry["stage"], set()).update(entry["reads"])
-    unread = {stage: sorted(keys - read[stage]) for stage, keys in declared.items() if keys - read[stage]}
+    return {stage: sorted(keys - read[stage]) for stage, keys in declared.items() if keys - read[stage]}, set(declared)
+
+
+def test_every_declared_key_is_read_by_its_jobs(study, quick_study_reads):
+    """A stage's declared keys are its rule's params (a change reruns it): each is read by a job of the stage
+    or it reruns jobs for nothing. Each command of the quick study logged the keys of its slice it read."""
+    unread, declared = unread_keys(quick_study_reads)
     assert not unread, f"declared and never read (stage: keys): {unread}"
     commands = {stage for stage in declared if not stage.startswith("figure ")}
     assert {"simulate", "features", "observed", "emulate", "calibrate", "predict", "sensitivity"} <= commands
@@ -477,14 +484,14 @@ def test_the_next_shot_check_without_a_ranking_stops_with_one_line(tmp_path):
 
 
 @pytest.mark.slow   # the last of this module's tests: its outputs would join the seed and noise tests' params checks
-def test_next_shot_check_target_on_the_quick_study(study):
+def test_next_shot_check_target_on_the_quick_study(study, tmp_path):
     """`snakemake next_shot_check` on the quick study (quick.yaml: 3 truths, 20 training runs per candidate): both
     candidates as fourth shots, their runs at the first 20 training rows and at the truths (the three shots'
     training runs reused, not rerun), the per-truth table and the summary with its verdicts; `all` untouched."""
     results, config = study
-    snakemake("next_shot", "--cores", "2", config_files=[config])
+    snakemake("next_shot", "--cores", "2", config_files=[config], read_log=tmp_path)
     ranking = pd.read_csv(results / "next_shot" / "ranking.csv")
-    snakemake("next_shot_check", "--cores", "2", config_files=[config])
+    snakemake("next_shot_check", "--cores", "2", config_files=[config], read_log=tmp_path)
     check = pd.read_csv(results / "next_shot" / "check.csv")
     assert set(check["candidate"]) == set(ranking["candidate"]) and check["run"].nunique() == 3
     sds = [f"{k}sd_{p}" for k in ("", "baseline_") for p in ("A", "B", "C", "n", "m")]
@@ -501,3 +508,7 @@ def test_next_shot_check_target_on_the_quick_study(study):
         assert len(list((results / "next_shot_check" / "simulations" / name).glob("chunk-*.parquet"))) == 2
     assert not (results / "next_shot_check" / "simulations" / "104S").exists()
     assert pending_jobs(config) == {} and pending_jobs(config, target="next_shot_check") == {}
+    unread, stages = unread_keys(tmp_path)              # every key the next-shot stages declare is read
+    assert not unread, f"declared and never read (stage: keys): {unread}"
+    assert {"next_shot_design", "next_shot_simulate", "next_shot_features", "suggest_shot", "next_shot_check_truths",
+            "calibrate_check", "next_shot_check_summary"} <= stages, stages
