@@ -131,3 +131,17 @@ def test_the_observed_stage_reads_its_sources_keys_alone(config, source, given, 
     assert given <= set(sliced["observed"]) and left_out not in sliced["observed"]
     assert ("features" in sliced) == (source == "records")     # the extractor's settings
     assert set(sliced["inputs"]) == {spec["velocity_input"] for spec in config["shots"].values()}
+
+
+def test_a_candidates_stages_read_its_reference_shot_alone(config):
+    """A candidate's design, runs and features read its reference shot's plates, moduli and window, not another
+    shot's: a change of 106S's window reruns no candidate of 104S (the check's truths read every candidate's)."""
+    study = {**config, "next_shot": {**config["next_shot"], "candidates": {
+        "hot": {**next(iter(config["next_shot"]["candidates"].values())), "shot": "105S"}}}}
+    for stage in ("next_shot_design", "next_shot_simulate", "next_shot_features"):
+        sliced = stage_config(study, stage, "hot")
+        assert set(sliced["shots"]) <= {"104S", "105S", "106S"} and all(
+            spec == {} for shot, spec in sliced["shots"].items() if shot != "105S"), stage
+        assert set(sliced["shots"]["105S"]) == {"flyer_mm", "target_mm", "shear_modulus_inputs", "analysis"}, stage
+    truths = stage_config(study, "next_shot_check_truths")
+    assert set(truths["shots"]) == {"105S"}

