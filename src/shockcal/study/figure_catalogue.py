@@ -262,8 +262,8 @@ def catalogue(config) -> dict[str, FigureSpec]:
         FigureSpec("features_vs_training", "2 data", _measured_against_training, _FEATURE_SPACE,
                    (*features, "observed")),
         # which shot next (`make next-shot`), when the config has candidates
-        *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets", "strength.model?", "inputs.{names}"), ("next_shot_ranking",),
-                      "next_shot")] if config.get("next_shot", {}).get("candidates") else []),
+        *([FigureSpec("next_shot", "7 next shot", _next_shot, ("next_shot.targets", "strength.model?", "inputs.{names}"),
+                      ("next_shot_ranking",), "next_shot")] if config.get("next_shot", {}).get("candidates") else []),
     ]
     return {spec.name: spec for spec in specs}
 
