@@ -100,7 +100,10 @@ NOT_READ_HERE = {
     "calibrate_check": ("calibration.check.trials",),          # the command without --trial-range
     "next_shot_simulate": ("inputs.",),                        # the units of the strength inputs alone
     "next_shot_features": ("material.", "inputs."),            # a window scaled by the plateau: the Hugoniot, the
-}                                                              # reference shot's modulus box
+                                                               # reference shot's modulus box
+    "next_shot_check_summary": ("inputs.",),                   # the law's parameters among the inputs' names,
+    "figure next_shot": ("inputs.",),                          # asked for by name (`strength_parameters`)
+}
 
 
 def test_every_declared_key_is_read_by_its_jobs(study, quick_study_reads):
