@@ -2,7 +2,8 @@
 
 Truths: rows of the study's joint posterior draws (`--truths-from`, native units). Records: the truth's features
 (`--eta`: `hydrocode`, the study's hydrocode and extractor at the truth, so the records carry the emulator's own
-error as real ones do; `emulator`, its mean, which leaves that error out), plus a discrepancy, plus 1% noise
+error as real ones do; `emulator`, its mean, which leaves that error out; `emulator-draw`, its mean plus a draw of
+its Gaussian error, so that with the term the likelihood is the records' own model), plus a discrepancy, plus 1% noise
 (lambda_y = 1); a truth whose run fails is reported and skipped. The discrepancy (`--records`):
 - `prior`: drawn from the feature-kind term's prior (`shockcal.inference.discrepancy`, `--sd-fraction-prior`);
 - `shift`: out of family, a per-shot timing error of the plastic rise: each shot's slope features (v_slope1,
@@ -104,7 +105,10 @@ def run(args):
     failed = []
     for trial in range(args.truths):
         theta = truths.iloc[int(rng.integers(len(truths)))]
-        eta = emulator.predict({n: np.array([theta[n]]) for n in names}, shots)[0][0]
+        mean, covariance = emulator.predict({n: np.array([theta[n]]) for n in names}, shots)[:2]
+        eta = mean[0]
+        if args.eta == "emulator-draw":        # the emulator's error drawn too: the likelihood is then exact
+            eta = eta + rng.multivariate_normal(np.zeros(len(eta)), covariance[0])
         if full is not None and trial >= args.skip:
             eta = hydrocode_features(full, theta, shots, features)
             if eta is None:
@@ -182,8 +186,8 @@ if __name__ == "__main__":
     parser.add_argument("--truths-from", required=True, help="the joint posterior's draws (Parquet, native units)")
     parser.add_argument("--observed", required=True, help="the measured features table (rise times, read-out)")
     parser.add_argument("--records", choices=["prior", "shift", "none"], default="prior")
-    parser.add_argument("--eta", choices=["hydrocode", "emulator"], default="hydrocode",
-                        help="the truth's features: the hydrocode's run, or the emulator's mean")
+    parser.add_argument("--eta", choices=["hydrocode", "emulator", "emulator-draw"], default="hydrocode",
+                        help="the truth's features: the hydrocode's run, the emulator's mean, or its mean plus a draw of its error")
     parser.add_argument("--truths", type=int, default=30)
     parser.add_argument("--sd-fraction-prior", type=float, default=0.02)
     parser.add_argument("--shift-ns", type=float, default=1.0, help="timing sd in read-out half-windows")
