@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from shockcal.emulator.study_emulator import Emulator
-from shockcal.errors import SamplerError
+from shockcal.errors import InputError, SamplerError
 from shockcal.inference.calibration import calibrate
 from shockcal.inference.discrepancy import SD_FRACTION_PREFIX, Discrepancy
 from shockcal.io import read_table
@@ -126,7 +126,7 @@ def run(args):
             start = time.process_time()
             try:
                 posterior = calibrate(emulator, shots, observed, settings, f"trial {trial}")
-            except SamplerError as exc:
+            except (SamplerError, InputError) as exc:     # the sampler's limit, or records the library refuses
                 failed.append((trial, kind, str(exc)))
                 print(f"  truth {trial + 1} left out: the {kind} calibration failed: {exc}", flush=True)
                 break
