@@ -6,6 +6,7 @@ Layers, each importing only those above it and the library:
   `emulator_spec`, `calibration_settings`, ...), the design and the measured features of the study;
 - `validate`: reading a config file, its schema and the rules across keys, the design file's check;
 - `stages`: which keys each stage reads (`STAGE_KEYS`), sliced for the workflow's params and the commands;
+  `read_log`: with SHOCKCAL_READ_LOG, what each command read of its slice (the tests' check of `stages`);
 - `strength_config`: the `strength` section: the law's prior box, checked before any run;
 - `candidate_studies`: the next-shot check's candidates as fourth shots of derived configs;
 - `figure_catalogue`: the figures, what each reads of the config and its inputs, and which function draws it;

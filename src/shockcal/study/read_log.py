@@ -3,9 +3,10 @@
 A stage's declared keys (`shockcal.study.stages`) are both the slice its command gets and its rule's `params`,
 whose change reruns the job. A key declared but never read reruns jobs for nothing. With the environment variable
 `SHOCKCAL_READ_LOG` naming a folder, each command's slice records the leaf keys its code reads (a value fetched by
-key, or every leaf under a section that is iterated, copied or unpacked whole), and the process writes one JSON
-file there at exit: the stage, the declared leaf keys and the read ones (`tests/test_workflow.py` runs the quick
-study with it). Without the variable nothing is wrapped.
+key; every leaf of a section whose items or values are listed, copied, dumped or unpacked whole; the names of a
+`{names}` section, listed or asked for), and the process writes one JSON file there at exit: the stage, the
+declared leaf keys and the read ones (`tests/test_workflow.py` runs the quick study with it). Without the variable
+nothing is wrapped.
 """
 
 from __future__ import annotations

@@ -12,9 +12,10 @@ serves both channels a stage gets its settings through:
 Path segments: a key; `*` every key at that level (e.g. every shot); `{shot}` the shot the job
 works on; `{shot_inputs}` the design columns that shot reads (`ShotMapping.inputs`); `{names}`, last,
 the names of the section's keys alone (`shots.{names}`: which shots, each an empty section, for a job
-that reads no shot's settings). A trailing `?`
-marks an optional key, sliced only when the config gives it: a key whose absence is its default (a
-shot's `initial_temperature_K`), so that declaring it reruns none of the jobs of configs without it.
+that reads no shot's settings). A trailing `?` marks an optional key, sliced only when the config gives
+it: a key whose absence is its default (a shot's `initial_temperature_K`), so that declaring it reruns
+none of the jobs of configs without it. A few keys depend on the config (`stage_config`): a law's
+material constants, the observed stage's source, a candidate's reference shot, the waves' criterion.
 """
 from __future__ import annotations
 
@@ -100,7 +101,7 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
                         "checks.plateau_vs_velocity",
                         "checks.features_in_training_range", "inputs", *_SHOT_MAPPING),
     # a sequential study's later wave (design.waves): the previous joint posterior thinned, the stopping rule
-    # (and observed.sd_fraction for the max_variance criterion, `_wave_keys`)
+    # (and observed.sd_fraction for the max_variance criterion, `_max_variance`)
     "wave_design": ("study.seed", "design.strategy", *model_keys(WaveSettings, "design.waves"), "inputs",
                     "checks.design_box", *_SHOT_MAPPING),
     # a new shot's design (design.new_shots): the base shots' joint posterior thinned, its own inputs drawn
