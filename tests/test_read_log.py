@@ -37,6 +37,13 @@ def test_a_slice_records_the_leaves_its_holder_reads(use, expected):
     assert reads(use) == expected
 
 
+def test_a_change_to_a_section_stays_in_the_slice():
+    """A command may override a setting in its slice: the wrapped section is the slice's own, not a copy."""
+    sliced = RecordingDict(copy.deepcopy(SLICE), set())
+    sliced["hydro"]["cfl"] = 0.25
+    assert sliced["hydro"]["cfl"] == 0.25
+
+
 def test_the_declared_leaves_are_every_leaf_and_every_name():
     assert leaf_paths(SLICE) == {"hydro.cfl", "hydro.cells", "shots.S1", "shots.S2", "inputs.A.min", "inputs.A.max"}
 

@@ -34,7 +34,10 @@ class RecordingDict(dict):
         if isinstance(value, dict):
             if not value:
                 self._reads.add(self._path(key))
-            return RecordingDict(value, self._reads, f"{self._path(key)}.")
+            if not isinstance(value, RecordingDict):   # wrapped once, in place: a change made to it stays
+                value = RecordingDict(value, self._reads, f"{self._path(key)}.")
+                dict.__setitem__(self, key, value)
+            return value
         self._reads.add(self._path(key))
         return value
 
