@@ -1,17 +1,20 @@
 """The hydrocode's verdict (shockcal.inference.verify): PSIS of the hydrocode-over-emulator likelihood ratios on toys
-with a known truth, and the hydrocode's likelihood as the emulator's with its share removed."""
+with a known truth, the hydrocode's likelihood as the emulator's with its share removed, and the emulator's error at
+the draws in the records' sds."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from scipy import stats
+from test_emulator import _fitted_and_unseen
 
 from shockcal.errors import ConfigError, InputError
 from shockcal.inference.problem import Problem
 from shockcal.inference.settings import VerifySettings
-from shockcal.inference.verify import corrected_quantiles, khat_threshold, psis_verdict
+from shockcal.inference.verify import corrected_quantiles, emulator_error_at_draws, khat_threshold, psis_verdict
 from shockcal.study.validate import validate_config
+from shockcal.velocimetry.columns import CALIBRATION_FEATURES
 
 S = 4000
 
@@ -46,7 +49,7 @@ def test_an_emulator_posterior_far_narrower_than_the_hydrocodes_fails_in_one_lin
     verdict = psis_verdict(gaussian_log_lik(theta, 1.0, 1.0), gaussian_log_lik(theta, 0.0, 0.2))
     assert not verdict.passed and verdict.khat > verdict.threshold
     line = verdict.line()
-    assert "\n" not in line and "the emulator misleads in the posterior region" in line and "another wave" in line
+    assert "\n" not in line and "the emulator misleads in the posterior region" in line and "design.waves" in line
     weights = np.exp(verdict.log_weights)                     # the line says why: few effective draws, sharp L_hydro
     assert 1.0 <= verdict.raw_ess < 0.1 * S and verdict.largest_weight > 1.0 / S
     assert verdict.log_lik_sd_hydrocode == pytest.approx(np.std(gaussian_log_lik(theta, 1.0, 1.0)), rel=1e-12)
@@ -106,3 +109,28 @@ def test_the_hydrocodes_likelihood_is_the_samplers_without_the_emulators_share()
     np.testing.assert_allclose(hydro, expected, rtol=1e-12)
     with_share = stats.norm.logpdf(observed, features, np.sqrt((0.01 * observed) ** 2 / lam[:, None] + [4, 9, 16]))
     np.testing.assert_allclose(problem(cov).log_likelihood(points), with_share.sum(axis=1), rtol=1e-12)
+
+
+def test_the_emulators_error_at_the_draws_is_read_in_the_records_sds(paper_config):
+    """At 200 runs the emulator never saw, with the hydrocode's features set to its mean plus known offsets: each
+    feature's RMSE in records' sds is the offset over that sd, the overall the root mean square of those, and the
+    line names the feature furthest off; failed runs are not scored, a records' sd per feature is required."""
+    emulator, new, new_features = _fitted_and_unseen(paper_config)
+    mean, _ = emulator.predict({k: new[k].to_numpy() for k in new.columns}, ["104S"])
+    offset, records_sd = np.array([0.3, 2.0, 0.5, 1.0]), np.array([1.0, 1.0, 2.0, 4.0])
+    shifted = new_features.copy()
+    shifted[CALIBRATION_FEATURES] = mean - offset
+    shifted["status"] = np.where(shifted["run"] < 5, "failed", "ok")
+    error = emulator_error_at_draws(emulator, new, {"104S": shifted}, records_sd)
+    table = error.table
+    np.testing.assert_allclose(table["rmse_m_s"].iloc[:-1], offset, rtol=1e-9)
+    np.testing.assert_allclose(table["rmse_records_sd"].iloc[:-1], offset / records_sd, rtol=1e-9)
+    assert error.rmse_records_sd == pytest.approx(np.sqrt(np.mean((offset / records_sd) ** 2)), rel=1e-9)
+    assert error.rmse_m_s == pytest.approx(np.sqrt(np.mean(offset ** 2)), rel=1e-9)
+    assert table["records_sd_m_s"].iloc[-1] == pytest.approx(np.sqrt(np.mean(records_sd ** 2)))
+    assert table["n_values"].iloc[0] == 195 and 0.0 <= error.region <= 1.0
+    line = error.line()
+    assert "\n" not in line and "195 draws" in line and "1 of 4 features above 1" in line
+    assert f"the most 104S:{CALIBRATION_FEATURES[1]} 2.00" in line
+    with pytest.raises(InputError, match="3 records' sds for 4 features"):
+        emulator_error_at_draws(emulator, new, {"104S": shifted}, records_sd[:3])

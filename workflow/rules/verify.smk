@@ -24,7 +24,8 @@ rule verify_design:
 
 
 rule verify:
-    """PSIS k-hat of the hydrocode-over-emulator likelihood ratios at the draws, and the corrected quantiles."""
+    """PSIS k-hat of the hydrocode-over-emulator likelihood ratios at the draws, the corrected quantiles, and the
+    emulator's error at the draws against the records' sd."""
     input:
         design=rules.verify_design.output[0],
         features=expand(rules.features.output[0], run_set="verify", shot=SHOTS),
@@ -32,7 +33,8 @@ rule verify:
         arrays=rules.emulator.output.arrays,
         observed=rules.observed.output[0],
     output:
-        PLAN.run_set_path("verify", "summary.csv"),
+        summary=PLAN.run_set_path("verify", "summary.csv"),
+        error=PLAN.run_set_path("verify", "emulator_error.csv"),
     log:
         f"{LOGS}/verify/summary.log",
     benchmark:
@@ -45,4 +47,4 @@ rule verify:
         emulator_dir=lambda w, input: os.path.dirname(input.emulator),
     shell:
         "shockcal verify --design {input.design} --features {params.features} --emulator {params.emulator_dir}"
-        " --observed {input.observed} --out {output} > {log} 2>&1"
+        " --observed {input.observed} --out {output.summary} --error-out {output.error} > {log} 2>&1"

@@ -6,7 +6,8 @@ read-out sd scaled by the draw's lambda_y, without the emulator's share), log w 
 ArviZ's Pareto-smoothed importance sampling (PSIS; Vehtari et al. 2024) smooths the weights and gives k-hat, the
 shape of their tail: below min(1 - 1/log10(S), 0.7) the smoothed weights correct the posterior's quantiles
 reliably; above it, the emulator's posterior and the hydrocode's differ too much for any reweighting, and the
-emulator misleads in the posterior region.
+emulator misleads in the posterior region. How far it misleads: its error at the same draws, which no fit saw,
+against the records' sd (`emulator_error_at_draws`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,9 @@ from shockcal.errors import InputError
 from shockcal.inference.settings import MIN_VERIFY_DRAWS
 from shockcal.inference.summaries import SUMMARY_QUANTILES, weighted_quantiles
 
-FAILED_VERDICT = ("k-hat {khat:.2f} > {threshold:.2f} (S = {n}): the emulator misleads in the posterior region; "
-                  "another wave is the cure (its corrected quantiles are not reported)")
+FAILED_VERDICT = ("k-hat {khat:.2f} > {threshold:.2f} (S = {n}): the emulator misleads in the posterior region "
+                  "(its error there: the next line); training runs placed there (another wave, design.waves) "
+                  "shrink that error (the corrected quantiles are not reported)")
 WEIGHTS_NOTE = ("; raw weights: Kish ESS {ess:.1f} of {n}, the largest {largest:.2f}; log-likelihood sd over the "
                 "draws: emulator {sd_emulator:.1f}, hydrocode {sd_hydrocode:.1f}")
 
@@ -118,3 +120,61 @@ def corrected_quantiles(draws: np.ndarray, names: list[str], verdict: Verdict, q
     table["khat"], table["khat_threshold"], table["passed"] = verdict.khat, verdict.threshold, verdict.passed
     table["n_draws"] = verdict.n_draws
     return table
+
+
+@dataclass(frozen=True)
+class EmulatorError:
+    """The emulator's error at the verify draws against the hydrocode's features, which no fit saw.
+
+    table: per shot and feature (`feature` "shot:name") and over all of them (the last row), `score_heldout`'s
+        columns (`rmse_m_s`, `coverage` of the error model's 90% band, `mean_z2`, `n_values`), the records' sd
+        (`records_sd_m_s`: the observation and read-out sd at lambda_y = 1; over all, their root mean square) and
+        `rmse_records_sd`, the RMSE in records' sds (over all, the root mean square of the features' values: the
+        scale on which the likelihood reads an error);
+    region: the share of draws inside the error model's 90% region over each block's features (the lowest
+        block's: the density the likelihood uses, `region_coverage`).
+    """
+
+    table: pd.DataFrame
+    region: float
+
+    @property
+    def rmse_m_s(self) -> float:
+        return float(self.table["rmse_m_s"].iloc[-1])
+
+    @property
+    def rmse_records_sd(self) -> float:
+        return float(self.table["rmse_records_sd"].iloc[-1])
+
+    def line(self) -> str:
+        """One line: the error's size in m/s and in the records' sds, and whether the error model holds it."""
+        features = self.table.iloc[:-1]
+        worst = features.loc[features["rmse_records_sd"].idxmax()]
+        above = int((features["rmse_records_sd"] > 1.0).sum())
+        return (f"the emulator at the {int(features['n_values'].iloc[0])} draws: RMSE {self.rmse_m_s:.2f} m/s, "
+                f"{self.rmse_records_sd:.2f} records' sds ({above} of {len(features)} features above 1, the most "
+                f"{worst['feature']} {worst['rmse_records_sd']:.2f}); its 90% bands hold "
+                f"{self.table['coverage'].iloc[-1]:.3f} of the features, its 90% region {self.region:.3f} of the draws")
+
+
+def emulator_error_at_draws(emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame],
+                            records_sd_m_s) -> EmulatorError:
+    """The emulator's error where the posterior lives: at the verify draws, against the hydrocode's features there.
+
+    Args:
+        emulator: the study's `Emulator`.
+        design: the draws, a `run` column and the calibrated inputs (native units).
+        features: shot -> the hydrocode's features at the draws (`run`, `status`, the features in m/s), in the
+            calibration's shot order; a draw is scored where every shot's run is "ok".
+        records_sd_m_s: (shots x features,) the records' sd (m/s, `Problem.obs_sd`), shot-major as the table.
+    """
+    from shockcal.emulator.heldout import region_coverage, score_heldout
+
+    table = score_heldout(emulator, design, features)
+    records_sd = np.asarray(records_sd_m_s, dtype=float)
+    if len(records_sd) != len(table) - 1:
+        raise InputError(f"verify: {len(records_sd)} records' sds for {len(table) - 1} features")
+    ratio = table["rmse_m_s"].to_numpy()[:-1] / records_sd
+    table["records_sd_m_s"] = [*records_sd, float(np.sqrt(np.mean(records_sd ** 2)))]
+    table["rmse_records_sd"] = [*ratio, float(np.sqrt(np.mean(ratio ** 2)))]
+    return EmulatorError(table, float(region_coverage(emulator, design, features)["coverage"].min()))
