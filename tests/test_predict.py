@@ -67,7 +67,8 @@ def test_cli_writes_the_design(paper_config, tmp_path, capsys):
     assert "nope.parquet does not exist" in capsys.readouterr().err
     assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(out),
                  "--stream", "nope"]) == 2
-    assert "--stream: unknown random stream 'nope'" in capsys.readouterr().err
+    assert "--stream: 'nope' is not a stream of posterior draws (posterior_draws, check_posterior, verify)" in \
+        capsys.readouterr().err
 
 
 def test_cli_carries_the_discrepancy_s_columns_after_lambda_y(paper_config, tmp_path):

@@ -25,7 +25,7 @@ def test_verify_runs_n_draws_posterior_draws_per_shot_through_the_simulate_rules
     assert jobs["verify_design"] == jobs["verify"] == 1
     assert jobs["calibrate"] == 1                                # the joint posterior only
     assert "simulate[predict]" not in jobs
-    assert "--n-runs 25 --stream verify" in out and "shockcal verify --design" in out
+    assert "--stream verify --out" in out and "shockcal verify --design" in out
     assert "--features 104S=" in out and " 105S=" in out and " 106S=" in out
     every = job_counts(snakemake("all", "--dry-run", config_files=[config]).stdout)
     assert not any("verify" in rule for rule in every)

@@ -71,11 +71,9 @@ rule check_posterior_design:
     conda:
         "../envs/shockcal.yaml"
     params:
-        settings=stage_config(config, "predict"),
-        runs=CHECK["trials"],
+        settings=stage_config(config, "check_posterior_design"),
     shell:
-        "shockcal predict --posterior {input.posterior} --n-runs {params.runs} --stream check_posterior"
-        " --out {output} > {log} 2>&1"
+        "shockcal predict --posterior {input.posterior} --stream check_posterior --out {output} > {log} 2>&1"
 
 
 rule calibration_check_batch:

@@ -17,10 +17,8 @@ rule verify_design:
         "../envs/shockcal.yaml"
     params:
         settings=stage_config(config, "verify_design"),
-        n_draws=config["verify"]["n_draws"],
     shell:
-        "shockcal predict --posterior {input.posterior} --n-runs {params.n_draws} --stream verify"
-        " --out {output} > {log} 2>&1"
+        "shockcal predict --posterior {input.posterior} --stream verify --out {output} > {log} 2>&1"
 
 
 rule verify:

@@ -11,6 +11,12 @@ EXAMPLE_PREDICT_EMULATOR = """\
 shockcal predict-emulator --config config/config.yaml --design results/predict/design.parquet \\
     --emulator results/emulator --out results/predict/emulator.parquet"""
 
+# a stream of joint-posterior draws (shockcal.seeds): the stage whose config slice the command reads, and the key
+# that sets how many draws it takes: the predictive runs, the posterior-truth check's truths, `make verify`'s draws
+DRAW_STREAMS = {"posterior_draws": ("predict", ("predict", "n_posterior_runs")),
+                "check_posterior": ("check_posterior_design", ("calibration", "check", "trials")),
+                "verify": ("verify_design", ("verify", "n_draws"))}
+
 
 def register(subparsers) -> None:
     p = add_command(subparsers, "predict", example=EXAMPLE_PREDICT,
@@ -18,11 +24,11 @@ def register(subparsers) -> None:
     add_config_argument(p)
     p.add_argument("--posterior", required=True, help="joint posterior samples (Parquet or CSV)")
     p.add_argument("--out", required=True, help="output Parquet design table of the drawn samples")
-    p.add_argument("--n-runs", type=int, default=None, help="override predict.n_posterior_runs")
+    p.add_argument("--n-runs", type=int, default=None, help="override the stream's number of draws")
     p.add_argument("--seed", type=int, default=None, help="override the seed (default: the study's --stream)")
     p.add_argument("--stream", default="posterior_draws",
-                   help="the study seed's stream the draw is seeded from (default posterior_draws; the posterior-truth "
-                        "check's truths: check_posterior)")
+                   help="what the draws are for, which seeds them from the study's seed and sets their number: "
+                        + "; ".join(f"{stream}: {'.'.join(key)}" for stream, (_, key) in DRAW_STREAMS.items()))
     p.set_defaults(func=run)
 
     e = add_command(subparsers, "predict-emulator", example=EXAMPLE_PREDICT_EMULATOR,
@@ -36,6 +42,8 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     import logging
+    import operator
+    from functools import reduce
 
     from shockcal.design.posterior_draws import draw_posterior_design
     from shockcal.errors import InputError
@@ -46,12 +54,12 @@ def run(args) -> int:
     from shockcal.study.config import input_names, prior_bounds
     from shockcal.study.stages import load_stage_config
 
-    config = load_stage_config(args.config, "predict")
-    n_runs = args.n_runs or config["predict"]["n_posterior_runs"]
-    try:
-        seed = stream_seed(config["study"]["seed"], args.stream) if args.seed is None else args.seed
-    except ValueError as exc:
-        raise InputError(f"--stream: {exc}") from None
+    if args.stream not in DRAW_STREAMS:
+        raise InputError(f"--stream: {args.stream!r} is not a stream of posterior draws ({', '.join(DRAW_STREAMS)})")
+    stage, count_key = DRAW_STREAMS[args.stream]
+    config = load_stage_config(args.config, stage)
+    n_runs = args.n_runs or reduce(operator.getitem, count_key, config)
+    seed = stream_seed(config["study"]["seed"], args.stream) if args.seed is None else args.seed
     posterior = read_table(args.posterior)
     shots = read_table_metadata(args.posterior).get("shots") if args.posterior.endswith((".parquet", ".pq")) else None
     if shots is not None and sorted(shots) != sorted(config["shots"]):

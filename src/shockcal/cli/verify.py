@@ -91,7 +91,7 @@ def run(args) -> int:
     design[LAMBDA_Y] = lambda_y.set_index("run")[LAMBDA_Y].reindex(design["run"]).to_numpy(float)
     if len(design) != settings.n_draws:
         raise InputError(f"{args.design}: {len(design)} draws, verify.n_draws is {settings.n_draws}; "
-                         "redraw them (`shockcal predict --stream verify --n-runs`)")
+                         "redraw them (`shockcal predict --stream verify`)")
     tables = read_shot_features(parse_pairs(args.features, "--features"), shots, emulator.feature_names)
     features, ok = hydrocode_features(tables, emulator.feature_names, design["run"].to_numpy())
     if not ok.all():

@@ -109,10 +109,12 @@ STAGE_KEYS: dict[str, tuple[str, ...]] = {
                         "design.waves.pool_size", "inputs", "checks.design_box", *_SHOT_MAPPING),
     # every run of a sequential study so far, one design and one features table per shot
     "merge_runs": ("inputs", "checks.design_box", *_SHOT_MAPPING),
-    # the posterior rows run through the hydrocode for predictions
+    # joint-posterior draws as a design (`shockcal predict --stream`, one stage per stream): the predictive runs,
+    # the posterior-truth check's truths, the hydrocode's verdict's draws (`make verify`)
     "predict": ("study.seed", "predict.n_posterior_runs", "inputs", "shots.{names}"),
-    # the hydrocode's verdict (`make verify`): its posterior draws, and their PSIS against the emulator's likelihood
+    "check_posterior_design": ("study.seed", "calibration.check.trials", "inputs", "shots.{names}"),
     "verify_design": ("study.seed", "verify.n_draws", "inputs", "shots.{names}"),
+    # the hydrocode's verdict: PSIS of the draws' hydrocode likelihood against the emulator's
     "verify": ("verify.n_draws", "calibration.discrepancy", "observed.sd_fraction", "inputs", "checks.design_box",
                *_SHOT_MAPPING),
     # Sobol indices of the emulator over the prior box and the joint posterior's 5-95% box
