@@ -1,12 +1,15 @@
 """`shockcal report-tables`: the report's tables as CSV and HTML from the posteriors, the CV table, the
-coverage checks and the Sobol table."""
+coverage checks and the Sobol table, and the records' sd the held-out table reads its error in."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from shockcal.cli import main
+from shockcal.cli.report import posterior_records_sd
+from shockcal.errors import InputError
 from shockcal.io import write_table
 
 
@@ -46,3 +49,18 @@ def test_heldout_options_go_together_in_one_line(tmp_path, capsys):
     assert main(["report-tables", "--heldout-emulator", str(tmp_path), "--out-dir", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith("--heldout-emulator, --heldout-design and --heldout-features go together") and "\n" not in err
+
+
+def test_the_records_sd_comes_from_a_posteriors_metadata_in_the_held_out_tables_shot_order(tmp_path):
+    """`posterior_records_sd`: the sd the posterior was calibrated with, reordered to the held-out features' shots;
+    a table without it, or a shot the posterior lacks, is an InputError naming the file."""
+    posterior = tmp_path / "joint.parquet"
+    features = ["v_elastic", "v_plastic"]
+    write_table(pd.DataFrame({"A": [0.002]}), posterior,
+                {"shots": ["104S", "105S"], "observed": [60.0, 200.0, 65.0, 350.0], "observed_sd_m_s": [1, 2, 3, 4]})
+    np.testing.assert_array_equal(posterior_records_sd(str(posterior), ["105S", "104S"], features), [3, 4, 1, 2])
+    with pytest.raises(InputError, match="without 106S"):
+        posterior_records_sd(str(posterior), ["104S", "106S"], features)
+    write_table(pd.DataFrame({"A": [0.002]}), tmp_path / "plain.parquet", {"shots": ["104S"]})
+    with pytest.raises(InputError, match="plain.parquet: not a posterior written by `shockcal calibrate`"):
+        posterior_records_sd(str(tmp_path / "plain.parquet"), ["104S"], features)

@@ -15,6 +15,7 @@ import pytest
 import shockcal
 from shockcal.errors import InputError
 from shockcal.inference.posterior_files import read_posterior
+from shockcal.io import read_table_metadata
 
 az = pytest.importorskip("arviz")
 REPO = Path(__file__).resolve().parents[1]
@@ -127,3 +128,7 @@ def test_the_report_scores_the_emulator_on_the_posteriors_predictive_runs(quick_
     region = table[table["feature"] == "region: 104S+105S+106S (12 features)"].iloc[0]
     assert region["n_values"] == runs and 0 <= region["coverage"] <= 1
     assert (results / "report" / "emulator_heldout.html").is_file()
+    sd = read_table_metadata(results / "posterior" / "joint.parquet")["observed_sd_m_s"]   # the joint's records' sd
+    np.testing.assert_allclose(features["records_sd_m_s"], sd, rtol=1e-5)
+    np.testing.assert_allclose(features["rmse_records_sd"], features["rmse_m_s"] / features["records_sd_m_s"], rtol=1e-5)
+    assert overall["rmse_records_sd"] == pytest.approx(np.sqrt(np.mean(features["rmse_records_sd"] ** 2)), rel=1e-5)

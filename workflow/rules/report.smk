@@ -60,11 +60,13 @@ rule report_coverage:
 
 
 rule report_heldout:
-    """The study's emulator on the posterior's predictive runs, which no fit saw: where the calibration uses it."""
+    """The study's emulator on the posterior's predictive runs, which no fit saw: where the calibration uses it, in
+    m/s and in the records' sds (the joint posterior's)."""
     input:
         emulator=rules.emulator.output.emulator,
         design=PLAN.run_set_path("predict", "design.parquet"),
         features=expand(rules.features.output[0], run_set="predict", shot=SHOTS),
+        posterior=expand(rules.calibrate.output.samples, name="joint"),
     output:
         report(
             f"{RESULTS}/report/emulator_heldout.html",
@@ -82,7 +84,8 @@ rule report_heldout:
         out_dir=lambda w, output: os.path.dirname(output[0]),
     shell:
         "shockcal report-tables --heldout-emulator {params.emulator_dir} --heldout-design {input.design}"
-        " --heldout-features {params.pairs} --out-dir {params.out_dir} > {log} 2>&1"
+        " --heldout-features {params.pairs} --heldout-posterior {input.posterior} --out-dir {params.out_dir}"
+        " > {log} 2>&1"
 
 
 rule report_discrepancy:

@@ -41,6 +41,8 @@ def register(subparsers) -> None:
                                             "posterior's predictive runs, results/predict/design.parquet)")
     p.add_argument("--heldout-features", nargs="+", default=[], metavar="SHOT=TABLE",
                    help="those runs' features per shot (shockcal features --out)")
+    p.add_argument("--heldout-posterior", help="optional: a posterior (shockcal calibrate --out) whose records' sd "
+                                               "the held-out error is also read in")
     p.add_argument("--discrepancy", nargs="+", default=[], metavar="NAME=POSTERIOR",
                    help="posteriors with a model discrepancy (shockcal calibrate --out): its sd in m/s per shot and "
                         "feature")
@@ -113,8 +115,8 @@ def run(args) -> int:
                           "(95% bootstrap half-widths)", csv=False)
     if args.heldout_emulator or args.heldout_design or args.heldout_features:
         written += _write(heldout_table(args), out, "emulator_heldout",
-                          "The emulator on hydrocode runs no fit saw (m/s): 90% band per feature, 90% region per "
-                          "feature vector")
+                          "The emulator on hydrocode runs no fit saw (m/s, and in the records' sds): 90% band per "
+                          "feature, 90% region per feature vector")
     discrepancy = parse_pairs(args.discrepancy, "--discrepancy")
     if discrepancy:
         written += _write(discrepancy_table(discrepancy), out, "discrepancy",
@@ -142,11 +144,30 @@ def heldout_table(args):
     design = read_table(args.heldout_design)
     features = {shot: read_table(path)
                 for shot, path in parse_pairs(args.heldout_features, "--heldout-features").items()}
+    records_sd = None if args.heldout_posterior is None else posterior_records_sd(
+        args.heldout_posterior, list(features), emulator.feature_names)
     regions = region_coverage(emulator, design, features)
     region_rows = pd.DataFrame({"feature": [f"region: {b} ({f} features)" for b, f in
                                             zip(regions["block"], regions["n_features"])],
                                 "coverage": regions["coverage"], "n_values": regions["n_runs"]})
-    return pd.concat([score_heldout(emulator, design, features), region_rows], ignore_index=True)
+    return pd.concat([score_heldout(emulator, design, features, records_sd_m_s=records_sd), region_rows],
+                     ignore_index=True)
+
+
+def posterior_records_sd(path: str, shots: list[str], feature_names: list[str]):
+    """The records' sd (m/s) a posterior was calibrated with (its metadata), shot-major for `shots`."""
+    from shockcal.errors import InputError
+    from shockcal.inference.inference_data import observed_frames
+    from shockcal.io import read_table_metadata
+
+    meta = read_table_metadata(path)
+    if not {"shots", "observed", "observed_sd_m_s"} <= set(meta):
+        raise InputError(f"{path}: not a posterior written by `shockcal calibrate` (no observed sd in its metadata)")
+    sd = observed_frames(meta["shots"], meta["observed"], meta["observed_sd_m_s"], feature_names)[1]
+    missing = [shot for shot in shots if shot not in sd.index]
+    if missing:
+        raise InputError(f"{path}: a posterior of shots {meta['shots']}, without {', '.join(missing)}")
+    return sd.loc[shots].to_numpy(float).ravel()
 
 
 def discrepancy_table(posteriors: dict):

@@ -10,21 +10,26 @@ import pandas as pd
 from scipy import stats
 
 from shockcal.emulator.study_emulator import Emulator
+from shockcal.errors import InputError
 
 
 def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame],
-                  level: float = 0.9) -> pd.DataFrame:
+                  level: float = 0.9, records_sd_m_s=None) -> pd.DataFrame:
     """The emulator's mean and band at held-out runs, per feature of every shot and over all of them.
 
     design: the runs' inputs (a `run` column and the design columns, in the design's native units);
     features: shot -> that shot's features table (`run`, `status`, the feature columns in m/s); only the
     runs with status "ok" for every shot are scored. Each feature's band is the central `level` interval
     of its block's error model, t_dof(0, scale sd^2), a Gaussian when dof is infinite.
+    records_sd_m_s: optional, the measured records' sd per shot and feature (m/s, shot-major in the order of
+    `features`, as `Problem.obs_sd`): the error is then also read in it.
 
     Returns one row per shot and feature (`feature` "shot:name") and a last row `all (N runs)`:
     `rmse_m_s` (root mean square of mean - simulated, m/s), `coverage` (share inside the band),
     `mean_z2` (mean squared error over the emulator's predictive variance: 1 when its sd is honest
-    before the error model's scale) and `n_values`."""
+    before the error model's scale) and `n_values`; with `records_sd_m_s`, `records_sd_m_s` (over all, its
+    root mean square) and `rmse_records_sd`, the RMSE over it (over all, the root mean square of the features'
+    values: the scale on which the likelihood reads an error, below 1 where the records cannot tell it)."""
     shots, runs, err, cov = _heldout_errors(emulator, design, features)
     z = err / np.sqrt(np.diagonal(cov, axis1=1, axis2=2))
     half_width = np.empty(err.shape[1])
@@ -36,7 +41,15 @@ def score_heldout(emulator: Emulator, design: pd.DataFrame, features: dict[str, 
                           "mean_z2": np.mean(z ** 2, axis=0), "n_values": len(runs)})
     overall = {"feature": f"all ({len(runs)} runs)", "rmse_m_s": float(np.sqrt(np.mean(err ** 2))),
                "coverage": float(inside.mean()), "mean_z2": float(np.mean(z ** 2)), "n_values": inside.size}
-    return pd.concat([table, pd.DataFrame([overall])], ignore_index=True)
+    table = pd.concat([table, pd.DataFrame([overall])], ignore_index=True)
+    if records_sd_m_s is not None:
+        records_sd = np.asarray(records_sd_m_s, dtype=float)
+        if records_sd.shape != (err.shape[1],):
+            raise InputError(f"{records_sd.size} records' sds for {err.shape[1]} features")
+        ratio = table["rmse_m_s"].to_numpy()[:-1] / records_sd
+        table["records_sd_m_s"] = [*records_sd, float(np.sqrt(np.mean(records_sd ** 2)))]
+        table["rmse_records_sd"] = [*ratio, float(np.sqrt(np.mean(ratio ** 2)))]
+    return table
 
 
 def region_coverage(emulator: Emulator, design: pd.DataFrame, features: dict[str, pd.DataFrame],

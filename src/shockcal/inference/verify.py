@@ -127,10 +127,8 @@ class EmulatorError:
     """The emulator's error at the verify draws against the hydrocode's features, which no fit saw.
 
     table: per shot and feature (`feature` "shot:name") and over all of them (the last row), `score_heldout`'s
-        columns (`rmse_m_s`, `coverage` of the error model's 90% band, `mean_z2`, `n_values`), the records' sd
-        (`records_sd_m_s`: the observation and read-out sd at lambda_y = 1; over all, their root mean square) and
-        `rmse_records_sd`, the RMSE in records' sds (over all, the root mean square of the features' values: the
-        scale on which the likelihood reads an error);
+        columns with the records' sd: `rmse_m_s`, `coverage` of the error model's 90% band, `mean_z2`, `n_values`,
+        `records_sd_m_s` (the observation and read-out sd at lambda_y = 1) and `rmse_records_sd`;
     region: the share of draws inside the error model's 90% region over each block's features (the lowest
         block's: the density the likelihood uses, `region_coverage`).
     """
@@ -170,11 +168,5 @@ def emulator_error_at_draws(emulator, design: pd.DataFrame, features: dict[str, 
     """
     from shockcal.emulator.heldout import region_coverage, score_heldout
 
-    table = score_heldout(emulator, design, features)
-    records_sd = np.asarray(records_sd_m_s, dtype=float)
-    if len(records_sd) != len(table) - 1:
-        raise InputError(f"verify: {len(records_sd)} records' sds for {len(table) - 1} features")
-    ratio = table["rmse_m_s"].to_numpy()[:-1] / records_sd
-    table["records_sd_m_s"] = [*records_sd, float(np.sqrt(np.mean(records_sd ** 2)))]
-    table["rmse_records_sd"] = [*ratio, float(np.sqrt(np.mean(ratio ** 2)))]
+    table = score_heldout(emulator, design, features, records_sd_m_s=records_sd_m_s)
     return EmulatorError(table, float(region_coverage(emulator, design, features)["coverage"].min()))
