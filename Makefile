@@ -108,9 +108,9 @@ check: $(INSTALLED)  ## synthetic-truth coverage checks of the study (calibratio
 	@echo "results: $(CURDIR)/$(STUDY_DIR)/posterior/coverage_emulator.parquet, coverage_hydrocode.parquet and coverage_posterior.parquet"
 	@echo "report:  their table joins $(CURDIR)/$(STUDY_DIR)/report.html at the next make study$(if $(filter paper,$(STUDY)), STUDY=paper)"
 
-verify: $(INSTALLED)  ## the hydrocode's verdict on the joint posterior: verify.n_draws draws run, PSIS k-hat, corrected quantiles (STUDY=paper: the paper's)
+verify: $(INSTALLED)  ## the hydrocode's verdict on the joint posterior: verify.n_draws draws run, PSIS k-hat, corrected quantiles, the emulator's error there (STUDY=paper: the paper's)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) verify $(STUDY_CONFIG)
-	@echo "results: $(CURDIR)/$(STUDY_DIR)/verify/summary.csv (the verdict: $(STUDY_DIR)/logs/verify/summary.log)"
+	@echo "results: $(CURDIR)/$(STUDY_DIR)/verify/summary.csv and emulator_error.csv (the verdict: $(STUDY_DIR)/logs/verify/summary.log)"
 
 next-shot: $(INSTALLED)  ## which shot next: rank next_shot.candidates by expected information gain (STUDY=paper: on the paper's study)
 	$(call snakemake,$(STUDY_DIR)) --cores $(CORES) next_shot $(STUDY_CONFIG)
