@@ -8,7 +8,7 @@ calibration uses the emulator, and a K-fold on a design crowded into the posteri
 paper design's 1000-run emulator on the sequential study's posterior runs).
 
     python benchmarks/posterior_heldout.py --results results/sequential [--other-emulator results/emulator] \
-        [--run-set verify]      # the draws `make verify` ran instead of the predictive runs
+        [--run-set verify]      # the draws `make verify` ran (it writes the same, in the records' sds too)
 """
 
 from __future__ import annotations
