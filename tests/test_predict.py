@@ -62,6 +62,11 @@ def test_cli_writes_the_design(paper_config, tmp_path, capsys):
     assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(other),
                  "--n-runs", "20", "--stream", "check_posterior"]) == 0
     assert not read_table(other).equals(design)                 # the check's truths: a stream of their own
+    for stream, n_draws in [("check_posterior", paper_config["calibration"]["check"]["trials"]),
+                            ("verify", paper_config["verify"]["n_draws"])]:   # each stream's own count, from its slice
+        assert main(["predict", "--config", CONFIG, "--posterior", str(posterior), "--out", str(other),
+                     "--stream", stream]) == 0
+        assert len(read_table(other)) == n_draws
     assert main(["predict", "--config", CONFIG, "--posterior", str(tmp_path / "nope.parquet"),
                  "--out", str(out)]) == 2
     assert "nope.parquet does not exist" in capsys.readouterr().err
