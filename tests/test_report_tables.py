@@ -58,7 +58,7 @@ def test_the_records_sd_comes_from_a_posteriors_metadata_in_the_held_out_tables_
     features = ["v_elastic", "v_plastic"]
     write_table(pd.DataFrame({"A": [0.002]}), posterior,
                 {"shots": ["104S", "105S"], "observed": [60.0, 200.0, 65.0, 350.0], "observed_sd_m_s": [1, 2, 3, 4]})
-    np.testing.assert_array_equal(posterior_records_sd(str(posterior), ["105S", "104S"], features), [3, 4, 1, 2])
+    np.testing.assert_allclose(posterior_records_sd(str(posterior), ["105S", "104S"], features), [3, 4, 1, 2], rtol=1e-12)
     with pytest.raises(InputError, match="without 106S"):
         posterior_records_sd(str(posterior), ["104S", "106S"], features)
     write_table(pd.DataFrame({"A": [0.002]}), tmp_path / "plain.parquet", {"shots": ["104S"]})
